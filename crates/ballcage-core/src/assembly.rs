@@ -1,0 +1,190 @@
+//! Scene → model and initial state, keeping only what the scene declares.
+
+use crate::error::SceneError;
+use crate::geometry::{PairGeometry, Shape};
+use crate::math::{Quat, Vec3};
+use crate::model::{Body, ContactPair, Model, Motion, RecordPlan, SpinProfile, State, TorqueLoad};
+use crate::scene::{LoadSpec, MotionKind, Scene};
+
+/// Builds the model and initial state of a scene (validating it first).
+pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
+    scene.validate()?;
+    let mut bodies = Vec::with_capacity(scene.bodies.len());
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let q0 = b.orientation;
+        let rot = Quat::from_quaternion(nalgebra::Quaternion::new(q0[0], q0[1], q0[2], q0[3]));
+        let (mass, inertia) = if b.is_integrated() {
+            let (m, i3) = b
+                .mass_properties()
+                .ok_or_else(|| SceneError::new(format!("bodies[{i}].mass"), "", "missing"))?;
+            (m, Vec3::from(i3))
+        } else {
+            (0.0, Vec3::zeros())
+        };
+        let axis = b
+            .spin_axis
+            .map(|a| Vec3::from(a).normalize())
+            .unwrap_or_else(Vec3::z);
+        let motion = match b.motion {
+            MotionKind::Fixed => Motion::Fixed,
+            MotionKind::Dynamic => Motion::Dynamic,
+            MotionKind::KinematicSpin => Motion::KinematicSpin(SpinProfile {
+                axis,
+                speed: b.spin_speed,
+                ramp: b.spin_ramp,
+            }),
+            MotionKind::Spin => {
+                let axis_body = rot.inverse() * axis;
+                let i_axis = axis_body.dot(&inertia.component_mul(&axis_body));
+                Motion::Spin {
+                    axis,
+                    axis_body,
+                    inertia: i_axis,
+                }
+            }
+        };
+        bodies.push(Body {
+            name: b.name.clone(),
+            motion,
+            mass,
+            inertia,
+            shape: Shape::from_spec(&b.shape),
+            initial_rotation: rot,
+        });
+    }
+
+    let mut pairs = Vec::with_capacity(scene.contacts.len());
+    for (i, c) in scene.contacts.iter().enumerate() {
+        let path = format!("contacts[{i}]");
+        let a = scene.body_index(&c.bodies[0]).ok_or_else(|| {
+            SceneError::new(
+                format!("{path}.bodies[0]"),
+                &c.bodies[0],
+                "no body of that name",
+            )
+        })?;
+        let b = scene.body_index(&c.bodies[1]).ok_or_else(|| {
+            SceneError::new(
+                format!("{path}.bodies[1]"),
+                &c.bodies[1],
+                "no body of that name",
+            )
+        })?;
+        let (geometry, swapped) = PairGeometry::select_with_points(
+            &scene.bodies[a].shape,
+            &scene.bodies[b].shape,
+            c.points,
+        )
+        .ok_or_else(|| {
+            SceneError::new(
+                format!("{path}.bodies"),
+                format!("{:?}", c.bodies),
+                "unsupported pair",
+            )
+        })?;
+        pairs.push(ContactPair {
+            name: c.pair_name(),
+            a,
+            b,
+            geometry,
+            swapped,
+            normal: c.normal.to_law(&format!("{path}.normal"))?,
+            friction: c
+                .friction
+                .as_ref()
+                .map(|f| f.to_law(&format!("{path}.friction")))
+                .transpose()?,
+        });
+    }
+
+    let torques = scene
+        .loads
+        .iter()
+        .map(|l| match l {
+            LoadSpec::Torque {
+                body,
+                axis,
+                magnitude,
+                ramp,
+            } => TorqueLoad {
+                body: scene.body_index(body).unwrap_or_default(),
+                axis: Vec3::from(*axis).normalize(),
+                magnitude: *magnitude,
+                ramp: *ramp,
+            },
+        })
+        .collect();
+
+    let record = RecordPlan {
+        tables: scene.record.tables.clone(),
+        bodies: if scene.record.bodies.is_empty() {
+            (0..bodies.len())
+                .filter(|&i| !matches!(bodies[i].motion, Motion::Fixed))
+                .collect()
+        } else {
+            scene
+                .record
+                .bodies
+                .iter()
+                .filter_map(|n| scene.body_index(n))
+                .collect()
+        },
+        pairs: if scene.record.contacts.is_empty() {
+            (0..pairs.len()).collect()
+        } else {
+            scene
+                .record
+                .contacts
+                .iter()
+                .filter_map(|n| pairs.iter().position(|p| &p.name == n))
+                .collect()
+        },
+    };
+
+    let state = State {
+        t: 0.0,
+        pos: scene
+            .bodies
+            .iter()
+            .map(|b| Vec3::from(b.position))
+            .collect(),
+        rot: bodies.iter().map(|b| b.initial_rotation).collect(),
+        vel: scene
+            .bodies
+            .iter()
+            .map(|b| Vec3::from(b.velocity))
+            .collect(),
+        omega: scene
+            .bodies
+            .iter()
+            .zip(&bodies)
+            .map(|(s, b)| b.initial_rotation.inverse() * Vec3::from(s.angular_velocity))
+            .collect(),
+    };
+    let integrated = (0..bodies.len())
+        .filter(|&i| bodies[i].is_integrated())
+        .collect();
+    let model = Model {
+        bodies,
+        integrated,
+        pairs,
+        torques,
+        gravity: Vec3::from(scene.world.gravity),
+        integrator: scene.simulation.integrator,
+        dt: scene.simulation.dt,
+        steps_per_output: scene.steps_per_output(),
+        total_steps: scene.total_steps(),
+        record,
+        name: scene.name.clone(),
+    };
+    let mut state = state;
+    // A spin body's velocity is only its spin about the axis.
+    for i in 0..model.bodies.len() {
+        if let Motion::Spin { axis_body, .. } = model.bodies[i].motion {
+            state.vel[i] = Vec3::zeros();
+            state.omega[i] = axis_body * state.omega[i].dot(&axis_body);
+        }
+    }
+    model.prescribe(0.0, &mut state);
+    Ok((model, state))
+}

@@ -1,0 +1,442 @@
+//! Narrow phase: where declared pairs touch.
+//!
+//! # Sign convention (the only place it is defined)
+//! A [`ContactPoint`] of the pair `(a, b)`:
+//! - `depth` δ [m] is positive when the surfaces overlap;
+//! - `normal` is a unit world vector pointing **from a toward b**: the normal
+//!   force on b is `+F_n·normal`, on a `−F_n·normal`;
+//! - `point` [m] is midway between the two surface points;
+//! - the penetration rate δ̇ = −(v_b(p) − v_a(p))·normal is positive while approaching.
+//!
+//! # Pair table
+//! | pair | method |
+//! |---|---|
+//! | half-space–ball, ball–ball, ball–cuboid | parry3d `query::contact` (exact for these convex pairs) |
+//! | cuboid–half-space | analytic: each vertex below the plane is a point |
+//! | cylinder–tube | analytic: `points` samples along the axis, the surface point farthest from the centreline |
+//! | ball–tube | analytic: distance to the centreline |
+
+mod tube;
+
+pub use tube::{CentrelinePoint, TubePath};
+
+use parry3d_f64::query;
+use parry3d_f64::shape::{Ball, Cuboid, HalfSpace};
+
+use crate::math::{Quat, Vec3, from_glam, to_glam, to_glam_pose};
+use crate::scene::ShapeSpec;
+
+/// A shape ready for queries.
+#[derive(Debug, Clone)]
+pub enum Shape {
+    /// Sphere.
+    Ball(Ball),
+    /// Box.
+    Cuboid(Cuboid),
+    /// Half-space (boundary through the body origin).
+    HalfSpace(HalfSpace),
+    /// Cylinder along the body x axis.
+    Cylinder {
+        /// Outer radius [m].
+        radius: f64,
+        /// Half-length [m].
+        half_length: f64,
+    },
+    /// Inside of a tube.
+    Tube(TubePath),
+}
+
+impl Shape {
+    /// Builds the query shape of a validated spec.
+    pub fn from_spec(spec: &ShapeSpec) -> Self {
+        match spec {
+            ShapeSpec::Ball { radius } => Self::Ball(Ball::new(*radius)),
+            ShapeSpec::Cuboid { half_extents } => {
+                Self::Cuboid(Cuboid::new(to_glam(&Vec3::from(*half_extents))))
+            }
+            ShapeSpec::HalfSpace { normal } => {
+                Self::HalfSpace(HalfSpace::new(to_glam(&Vec3::from(*normal).normalize())))
+            }
+            ShapeSpec::Cylinder {
+                radius,
+                half_length,
+                ..
+            } => Self::Cylinder {
+                radius: *radius,
+                half_length: *half_length,
+            },
+            ShapeSpec::Tube {
+                inner_radius,
+                start,
+                direction,
+                segments,
+            } => Self::Tube(TubePath::new(
+                *inner_radius,
+                Vec3::from(*start),
+                Vec3::from(*direction),
+                segments,
+            )),
+        }
+    }
+}
+
+/// One point of contact; see the module doc for the sign convention.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    /// Stable index of this point within its pair (vertex, sample), for per-point memory.
+    pub slot: u32,
+    /// Midpoint between the surfaces [m], world frame.
+    pub point: Vec3,
+    /// Unit normal from body a toward body b, world frame.
+    pub normal: Vec3,
+    /// Overlap δ > 0 [m].
+    pub depth: f64,
+}
+
+/// How a pair's contact points are found; chosen once, at assembly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PairGeometry {
+    /// parry's convex–convex query, one deepest point (ball–half-space, ball–ball, ball–cuboid).
+    ParryConvex,
+    /// Cuboid vertices against a half-space, up to 8 points.
+    CuboidHalfSpace,
+    /// Cylinder inside a tube, `points` samples.
+    CylinderTube {
+        /// Samples along the axis.
+        points: u32,
+    },
+    /// Ball inside a tube.
+    BallTube,
+}
+
+impl PairGeometry {
+    /// Supported pairs, for messages.
+    pub const SUPPORTED: &'static str =
+        "ball–half-space, ball–ball, ball–cuboid, cuboid–half-space, cylinder–tube, ball–tube";
+
+    /// The method for a pair of shapes in either order, or `None` if unsupported.
+    /// The returned flag is true when the canonical order is (b, a).
+    pub fn select(a: &ShapeSpec, b: &ShapeSpec) -> Option<(Self, bool)> {
+        Self::select_with_points(a, b, 5)
+    }
+
+    /// As [`select`](Self::select), with the cylinder–tube sample count.
+    pub fn select_with_points(a: &ShapeSpec, b: &ShapeSpec, points: u32) -> Option<(Self, bool)> {
+        use ShapeSpec as S;
+        let canonical = |x: &ShapeSpec, y: &ShapeSpec| -> Option<Self> {
+            match (x, y) {
+                // Half-space first: parry 0.30's support-map–half-space order
+                // applies the relative pose uninverted (wrong depth); the
+                // half-space–support-map order is correct.
+                (S::HalfSpace { .. }, S::Ball { .. }) => Some(Self::ParryConvex),
+                (S::Ball { .. }, S::Ball { .. } | S::Cuboid { .. }) => Some(Self::ParryConvex),
+                (S::Cuboid { .. }, S::HalfSpace { .. }) => Some(Self::CuboidHalfSpace),
+                (S::Tube { .. }, S::Cylinder { .. }) => Some(Self::CylinderTube { points }),
+                (S::Tube { .. }, S::Ball { .. }) => Some(Self::BallTube),
+                _ => None,
+            }
+        };
+        canonical(a, b)
+            .map(|g| (g, false))
+            .or_else(|| canonical(b, a).map(|g| (g, true)))
+    }
+
+    /// Number of point slots a pair of this kind can report.
+    pub fn slots(self) -> usize {
+        match self {
+            Self::ParryConvex | Self::BallTube => 1,
+            Self::CuboidHalfSpace => 8,
+            Self::CylinderTube { points } => points as usize,
+        }
+    }
+
+    /// Appends the contact points of shapes 1 and 2 at the given poses, with
+    /// normals from shape 1 toward shape 2 (canonical order).
+    pub fn contacts(
+        self,
+        s1: &Shape,
+        p1: (&Vec3, &Quat),
+        s2: &Shape,
+        p2: (&Vec3, &Quat),
+        out: &mut Vec<ContactPoint>,
+    ) {
+        match (self, s1, s2) {
+            (Self::ParryConvex, _, _) => parry_convex(s1, p1, s2, p2, out),
+            (Self::CuboidHalfSpace, Shape::Cuboid(c), Shape::HalfSpace(h)) => {
+                cuboid_half_space(c, p1, h, p2, out)
+            }
+            (
+                Self::CylinderTube { points },
+                Shape::Tube(t),
+                Shape::Cylinder {
+                    radius,
+                    half_length,
+                },
+            ) => cylinder_tube(t, p1, *radius, *half_length, points, p2, out),
+            (Self::BallTube, Shape::Tube(t), Shape::Ball(b)) => ball_tube(t, p1, b.radius, p2, out),
+            _ => {}
+        }
+    }
+}
+
+fn parry_convex(
+    s1: &Shape,
+    p1: (&Vec3, &Quat),
+    s2: &Shape,
+    p2: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let (Some(g1), Some(g2)) = (parry_shape(s1), parry_shape(s2)) else {
+        return;
+    };
+    let pose1 = to_glam_pose(p1.0, p1.1);
+    let pose2 = to_glam_pose(p2.0, p2.1);
+    if let Ok(Some(c)) = query::contact(&pose1, g1, &pose2, g2, 0.0)
+        && c.dist < 0.0
+    {
+        out.push(ContactPoint {
+            slot: 0,
+            point: 0.5 * (from_glam(c.point1) + from_glam(c.point2)),
+            normal: from_glam(c.normal1),
+            depth: -c.dist,
+        });
+    }
+}
+
+fn parry_shape(s: &Shape) -> Option<&dyn parry3d_f64::shape::Shape> {
+    match s {
+        Shape::Ball(b) => Some(b),
+        Shape::Cuboid(c) => Some(c),
+        Shape::HalfSpace(h) => Some(h),
+        _ => None,
+    }
+}
+
+fn cuboid_half_space(
+    c: &Cuboid,
+    pc: (&Vec3, &Quat),
+    h: &HalfSpace,
+    ph: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let n = ph.1 * from_glam(h.normal);
+    let he = from_glam(c.half_extents);
+    for k in 0..8u32 {
+        let local = Vec3::new(
+            if k & 1 == 0 { -he.x } else { he.x },
+            if k & 2 == 0 { -he.y } else { he.y },
+            if k & 4 == 0 { -he.z } else { he.z },
+        );
+        let v = pc.0 + pc.1 * local;
+        let d = (v - ph.0).dot(&n);
+        if d < 0.0 {
+            // Normal from the cuboid (1) toward the half-space (2) is −n.
+            out.push(ContactPoint {
+                slot: k,
+                point: v - 0.5 * d * n,
+                normal: -n,
+                depth: -d,
+            });
+        }
+    }
+}
+
+/// Wall contact of a surface point `w` in tube frame; normal from the tube toward the body (inward).
+fn wall_contact(t: &TubePath, w: &Vec3) -> Option<(Vec3, Vec3, f64)> {
+    let c = t.nearest(w)?;
+    let r = w - c.point;
+    let d = r.norm();
+    let depth = d - t.inner_radius;
+    if depth <= 0.0 || d < 1e-15 {
+        return None;
+    }
+    let out = r / d;
+    Some((w - 0.5 * depth * out, -out, depth))
+}
+
+fn cylinder_tube(
+    t: &TubePath,
+    pt: (&Vec3, &Quat),
+    radius: f64,
+    half_length: f64,
+    points: u32,
+    pc: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    // Work in the tube frame.
+    let inv = pt.1.inverse();
+    let centre = inv * (pc.0 - pt.0);
+    let axis = inv * (pc.1 * Vec3::x());
+    let n = points.max(2);
+    for k in 0..n {
+        let s = -half_length + 2.0 * half_length * f64::from(k) / f64::from(n - 1);
+        let q = centre + s * axis;
+        let Some(c) = t.nearest(&q) else { continue };
+        let r = q - c.point;
+        let across = r - r.dot(&axis) * axis;
+        let len = across.norm();
+        if len < 1e-15 {
+            continue;
+        }
+        let w = q + radius * across / len;
+        if let Some((p, nrm, depth)) = wall_contact(t, &w) {
+            out.push(ContactPoint {
+                slot: k,
+                point: pt.0 + pt.1 * p,
+                normal: pt.1 * nrm,
+                depth,
+            });
+        }
+    }
+}
+
+fn ball_tube(
+    t: &TubePath,
+    pt: (&Vec3, &Quat),
+    radius: f64,
+    pb: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let inv = pt.1.inverse();
+    let centre = inv * (pb.0 - pt.0);
+    let Some(c) = t.nearest(&centre) else { return };
+    let r = centre - c.point;
+    let d = r.norm();
+    if d < 1e-15 {
+        return;
+    }
+    let w = centre + radius * r / d;
+    if let Some((p, nrm, depth)) = wall_contact(t, &w) {
+        out.push(ContactPoint {
+            slot: 0,
+            point: pt.0 + pt.1 * p,
+            normal: pt.1 * nrm,
+            depth,
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn pose(p: [f64; 3]) -> (Vec3, Quat) {
+        (Vec3::from(p), Quat::identity())
+    }
+
+    #[test]
+    fn ball_on_half_space_depth_and_normal_follow_the_convention() {
+        let ground = ShapeSpec::HalfSpace {
+            normal: [0.0, 0.0, 1.0],
+        };
+        let ball = ShapeSpec::Ball { radius: 0.1 };
+        // Declared either way round, the pair resolves to half-space first.
+        assert_eq!(
+            PairGeometry::select(&ball, &ground),
+            Some((PairGeometry::ParryConvex, true))
+        );
+        assert_eq!(
+            PairGeometry::select(&ground, &ball),
+            Some((PairGeometry::ParryConvex, false))
+        );
+        let (ground, ball) = (Shape::from_spec(&ground), Shape::from_spec(&ball));
+        for z in [0.099, 0.0999, 0.05] {
+            let (g, b) = (pose([0.3, -0.2, 0.0]), pose([0.0, 0.0, z]));
+            let mut out = vec![];
+            PairGeometry::ParryConvex.contacts(
+                &ground,
+                (&g.0, &g.1),
+                &ball,
+                (&b.0, &b.1),
+                &mut out,
+            );
+            assert_eq!(out.len(), 1);
+            assert_relative_eq!(out[0].depth, 0.1 - z, epsilon = 1e-12);
+            assert_relative_eq!(out[0].normal, Vec3::z(), epsilon = 1e-12);
+            assert_relative_eq!(out[0].point.z, -(0.1 - z) / 2.0, epsilon = 1e-12);
+        }
+        let b = pose([0.0, 0.0, 0.1001]);
+        let g = pose([0.0; 3]);
+        let mut out = vec![];
+        PairGeometry::ParryConvex.contacts(&ground, (&g.0, &g.1), &ball, (&b.0, &b.1), &mut out);
+        assert!(out.is_empty(), "a ball above the plane does not touch it");
+    }
+
+    #[test]
+    fn ball_against_a_cuboid_face_has_the_face_normal() {
+        let ball = Shape::from_spec(&ShapeSpec::Ball { radius: 0.05 });
+        let cube = Shape::from_spec(&ShapeSpec::Cuboid {
+            half_extents: [0.1, 0.2, 0.3],
+        });
+        let (pb, pc) = (pose([-0.149, 0.01, 0.02]), pose([0.0; 3]));
+        let mut out = vec![];
+        PairGeometry::ParryConvex.contacts(&ball, (&pb.0, &pb.1), &cube, (&pc.0, &pc.1), &mut out);
+        assert_eq!(out.len(), 1);
+        assert_relative_eq!(out[0].depth, 1e-3, epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, Vec3::x(), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn separated_balls_have_no_contact_and_overlapping_ones_have_one() {
+        let a = Shape::from_spec(&ShapeSpec::Ball { radius: 0.1 });
+        let (p1, p2, p3) = (
+            pose([0.0; 3]),
+            pose([0.21, 0.0, 0.0]),
+            pose([0.19, 0.0, 0.0]),
+        );
+        let mut out = vec![];
+        PairGeometry::ParryConvex.contacts(&a, (&p1.0, &p1.1), &a, (&p2.0, &p2.1), &mut out);
+        assert!(out.is_empty());
+        PairGeometry::ParryConvex.contacts(&a, (&p1.0, &p1.1), &a, (&p3.0, &p3.1), &mut out);
+        assert_relative_eq!(out[0].depth, 0.01, epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, Vec3::x(), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn tilted_cuboid_touches_with_its_lowest_vertices() {
+        let c = Shape::from_spec(&ShapeSpec::Cuboid {
+            half_extents: [0.1, 0.2, 0.3],
+        });
+        let h = Shape::from_spec(&ShapeSpec::HalfSpace {
+            normal: [0.0, 0.0, 1.0],
+        });
+        let (pc, ph) = (pose([0.0, 0.0, 0.299]), pose([0.0; 3]));
+        let mut out = vec![];
+        PairGeometry::CuboidHalfSpace.contacts(&c, (&pc.0, &pc.1), &h, (&ph.0, &ph.1), &mut out);
+        assert_eq!(out.len(), 4);
+        for p in &out {
+            assert_relative_eq!(p.depth, 1e-3, epsilon = 1e-12);
+            assert_relative_eq!(p.normal, Vec3::new(0.0, 0.0, -1.0), epsilon = 1e-12);
+        }
+    }
+
+    #[test]
+    fn cylinder_lying_in_a_straight_tube_touches_along_its_bottom_line() {
+        let tube = Shape::from_spec(&ShapeSpec::Tube {
+            inner_radius: 0.058,
+            start: [-1.0, 0.0, 0.0],
+            direction: [1.0, 0.0, 0.0],
+            segments: vec![crate::scene::TubeSegmentSpec::Straight { length: 2.0 }],
+        });
+        let cyl = Shape::Cylinder {
+            radius: 0.043,
+            half_length: 0.1,
+        };
+        let pt = pose([0.0; 3]);
+        let pc = pose([0.0, 0.0, -0.0151]);
+        let mut out = vec![];
+        PairGeometry::CylinderTube { points: 5 }.contacts(
+            &tube,
+            (&pt.0, &pt.1),
+            &cyl,
+            (&pc.0, &pc.1),
+            &mut out,
+        );
+        assert_eq!(out.len(), 5);
+        for p in &out {
+            assert_relative_eq!(p.depth, 1e-4, epsilon = 1e-12);
+            assert_relative_eq!(p.normal, Vec3::z(), epsilon = 1e-12);
+        }
+    }
+}

@@ -1,0 +1,129 @@
+//! Fixed-step integrators. They see only states and accelerations, never contacts.
+//!
+//! Translation is integrated in the world frame. Rotation is integrated on the
+//! manifold: the body-frame angular velocity drives a rotation vector ξ with
+//! `R = R₀·Exp(ξ)` (Runge–Kutta–Munthe-Kaas), so quaternions never leave the
+//! unit sphere by more than round-off.
+
+use crate::dynamics::{Accel, Dynamics, Mode};
+use crate::math::{Vec3, dexp_inv, exp_map};
+use crate::model::{Model, State};
+use crate::scene::IntegratorKind;
+
+/// Scratch space of an integrator; allocate once per simulation.
+#[derive(Debug, Clone)]
+pub struct Workspace {
+    acc: [Accel; 4],
+    /// Position rates of the stages (velocities) [m/s].
+    kx: [Vec<Vec3>; 4],
+    /// Rotation-vector rates of the stages [rad/s].
+    kq: [Vec<Vec3>; 4],
+    stage: State,
+}
+
+impl Workspace {
+    /// Workspace for `state`'s body count.
+    pub fn new(state: &State) -> Self {
+        let n = state.pos.len();
+        let z = vec![Vec3::zeros(); n];
+        Self {
+            acc: [
+                Accel::zeros(n),
+                Accel::zeros(n),
+                Accel::zeros(n),
+                Accel::zeros(n),
+            ],
+            kx: [z.clone(), z.clone(), z.clone(), z.clone()],
+            kq: [z.clone(), z.clone(), z.clone(), z],
+            stage: state.clone(),
+        }
+    }
+}
+
+/// Advances `state` by one step of `h` seconds with the model's integrator.
+pub fn step(
+    kind: IntegratorKind,
+    model: &Model,
+    dynamics: &mut Dynamics,
+    ws: &mut Workspace,
+    state: &mut State,
+    h: f64,
+) {
+    match kind {
+        IntegratorKind::SymplecticEuler => symplectic_euler(model, dynamics, ws, state, h),
+        IntegratorKind::Rk4 => rk4(model, dynamics, ws, state, h),
+    }
+}
+
+/// v ← v + h·a(x, v); x ← x + h·v; R ← R·Exp(h·ω).
+fn symplectic_euler(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    ws: &mut Workspace,
+    state: &mut State,
+    h: f64,
+) {
+    let acc = &mut ws.acc[0];
+    dynamics.accelerations(model, state, Mode::Commit, acc);
+    for &i in &model.integrated {
+        state.vel[i] += h * acc.lin[i];
+        state.omega[i] += h * acc.ang[i];
+        state.pos[i] += h * state.vel[i];
+        state.rot[i] = state.rot[i] * exp_map(&(h * state.omega[i]));
+        state.rot[i].renormalize_fast();
+    }
+    state.t += h;
+    model.prescribe(state.t, state);
+}
+
+/// Classical RK4 in (x, v, ω) with RKMK4 for the rotation vector.
+fn rk4(model: &Model, dynamics: &mut Dynamics, ws: &mut Workspace, state: &mut State, h: f64) {
+    const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
+    const W: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
+    let Workspace { acc, kx, kq, stage } = ws;
+    for s in 0..4 {
+        if s == 0 {
+            stage.clone_from(state);
+        } else {
+            let c = C[s] * h;
+            stage.t = state.t + c;
+            for &i in &model.integrated {
+                stage.pos[i] = state.pos[i] + c * kx[s - 1][i];
+                stage.vel[i] = state.vel[i] + c * acc[s - 1].lin[i];
+                stage.omega[i] = state.omega[i] + c * acc[s - 1].ang[i];
+                let xi = c * kq[s - 1][i];
+                stage.rot[i] = state.rot[i] * exp_map(&xi);
+                kq[s][i] = dexp_inv(&xi, &stage.omega[i]);
+                kx[s][i] = stage.vel[i];
+            }
+            model.prescribe(stage.t, stage);
+        }
+        if s == 0 {
+            for &i in &model.integrated {
+                kx[0][i] = state.vel[i];
+                kq[0][i] = state.omega[i];
+            }
+        }
+        let mode = if s == 0 { Mode::Commit } else { Mode::Trial };
+        dynamics.accelerations(model, stage, mode, &mut acc[s]);
+    }
+    for &i in &model.integrated {
+        let mut dx = Vec3::zeros();
+        let mut dv = Vec3::zeros();
+        let mut dw = Vec3::zeros();
+        let mut xi = Vec3::zeros();
+        for s in 0..4 {
+            dx += W[s] * kx[s][i];
+            dv += W[s] * acc[s].lin[i];
+            dw += W[s] * acc[s].ang[i];
+            xi += W[s] * kq[s][i];
+        }
+        state.pos[i] += h * dx;
+        state.vel[i] += h * dv;
+        state.omega[i] += h * dw;
+        state.rot[i] = state.rot[i] * exp_map(&(h * xi));
+        state.rot[i].renormalize_fast();
+    }
+    state.t += h;
+    model.prescribe(state.t, state);
+}

@@ -1,0 +1,56 @@
+//! Scalar and small dense types used throughout the engine.
+//!
+//! The engine computes in nalgebra types (`Vec3`, `Quat`, `Mat3`); parry's
+//! glam types appear only inside `geometry`, converted at the call.
+
+/// Scalar type: every quantity is an `f64` in SI units.
+pub type Real = f64;
+/// A 3-vector (position [m], velocity [m/s], force [N], ...).
+pub type Vec3 = nalgebra::Vector3<Real>;
+/// A unit quaternion: body orientation, body frame → world frame.
+pub type Quat = nalgebra::UnitQuaternion<Real>;
+/// A 3×3 matrix (inertia tensors [kg·m²], Jacobian blocks).
+pub type Mat3 = nalgebra::Matrix3<Real>;
+
+/// Converts to parry's vector type.
+#[inline]
+pub(crate) fn to_glam(v: &Vec3) -> parry3d_f64::math::Vector {
+    parry3d_f64::math::Vector::new(v.x, v.y, v.z)
+}
+
+/// Converts from parry's vector type.
+#[inline]
+pub(crate) fn from_glam(v: parry3d_f64::math::Vector) -> Vec3 {
+    Vec3::new(v.x, v.y, v.z)
+}
+
+/// Converts a pose to parry's pose type.
+#[inline]
+pub(crate) fn to_glam_pose(p: &Vec3, q: &Quat) -> parry3d_f64::math::Pose {
+    let r = parry3d_f64::math::Rotation::from_xyzw(q.i, q.j, q.k, q.w);
+    parry3d_f64::math::Pose::from_parts(to_glam(p), r)
+}
+
+/// Rotation vector (axis × angle [rad]) to unit quaternion, exact.
+#[inline]
+pub fn exp_map(rotation_vector: &Vec3) -> Quat {
+    Quat::from_scaled_axis(*rotation_vector)
+}
+
+/// Inverse of the right Jacobian of SO(3) applied to `w`: the rate ξ̇ of the
+/// rotation vector ξ in `R = R0·Exp(ξ)` when the body-frame angular velocity is `w`.
+///
+/// ξ̇ = w + ½ ξ×w + (1/θ² − (1+cos θ)/(2θ sin θ)) ξ×(ξ×w), θ = |ξ|; the last
+/// coefficient tends to 1/12 as θ → 0.
+#[inline]
+pub fn dexp_inv(xi: &Vec3, w: &Vec3) -> Vec3 {
+    let th2 = xi.norm_squared();
+    let c = if th2 < 1e-8 {
+        1.0 / 12.0 + th2 / 720.0
+    } else {
+        let th = th2.sqrt();
+        1.0 / th2 - (1.0 + th.cos()) / (2.0 * th * th.sin())
+    };
+    let xw = xi.cross(w);
+    w + 0.5 * xw + c * xi.cross(&xw)
+}

@@ -1,0 +1,214 @@
+//! The assembled, read-only model and the mutable state it acts on.
+
+use crate::force::{FrictionLaw, NormalLaw, step};
+use crate::geometry::{PairGeometry, Shape};
+use crate::math::{Quat, Vec3};
+use crate::scene::{IntegratorKind, TableKind};
+
+/// How an assembled body moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Motion {
+    /// Never moves.
+    Fixed,
+    /// Six degrees of freedom.
+    Dynamic,
+    /// Prescribed spin about a world axis through the centre of mass.
+    KinematicSpin(SpinProfile),
+    /// One degree of freedom: spin about a world axis through the fixed centre of mass.
+    Spin {
+        /// Unit spin axis, world frame.
+        axis: Vec3,
+        /// The same axis in the body frame (fixed in the body as it spins).
+        axis_body: Vec3,
+        /// Moment of inertia about the axis [kg·m²].
+        inertia: f64,
+    },
+}
+
+/// A spin drive: speed ramped by an Adams STEP from 0 to `speed` over `ramp`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpinProfile {
+    /// Unit spin axis, world frame.
+    pub axis: Vec3,
+    /// Final speed [rad/s].
+    pub speed: f64,
+    /// Ramp duration [s].
+    pub ramp: f64,
+}
+
+impl SpinProfile {
+    /// Spin angle θ(t) [rad]: ω₀t_r(τ³ − τ⁴/2), τ = t/t_r, during the ramp;
+    /// ω₀(t − t_r/2) after it.
+    pub fn angle(&self, t: f64) -> f64 {
+        if self.ramp <= 0.0 || t >= self.ramp {
+            self.speed * (t - 0.5 * self.ramp)
+        } else if t <= 0.0 {
+            0.0
+        } else {
+            let tau = t / self.ramp;
+            self.speed * self.ramp * (tau.powi(3) - 0.5 * tau.powi(4))
+        }
+    }
+
+    /// Spin speed ω(t) = STEP(t, 0, 0, t_r, ω₀) [rad/s].
+    pub fn speed_at(&self, t: f64) -> f64 {
+        if self.ramp <= 0.0 {
+            self.speed
+        } else {
+            step(t, 0.0, 0.0, self.ramp, self.speed).0
+        }
+    }
+}
+
+/// An assembled body. Indices into [`Model::bodies`] are body ids.
+#[derive(Debug, Clone)]
+pub struct Body {
+    /// Name from the scene.
+    pub name: String,
+    /// How it moves.
+    pub motion: Motion,
+    /// Mass [kg]; 0 for fixed and kinematic bodies.
+    pub mass: f64,
+    /// Principal inertia about body x, y, z [kg·m²].
+    pub inertia: Vec3,
+    /// Query shape.
+    pub shape: Shape,
+    /// Initial orientation (kinematic spin is applied on top of it).
+    pub initial_rotation: Quat,
+}
+
+impl Body {
+    /// Whether the integrator advances this body.
+    pub fn is_integrated(&self) -> bool {
+        matches!(self.motion, Motion::Dynamic | Motion::Spin { .. })
+    }
+}
+
+/// A declared contact pair with its laws.
+#[derive(Debug, Clone)]
+pub struct ContactPair {
+    /// Name in outputs.
+    pub name: String,
+    /// Body a (normals point from a toward b).
+    pub a: usize,
+    /// Body b.
+    pub b: usize,
+    /// Point finder.
+    pub geometry: PairGeometry,
+    /// True when the geometry's canonical order is (b, a).
+    pub swapped: bool,
+    /// Normal law, SI.
+    pub normal: NormalLaw,
+    /// Friction law, if any.
+    pub friction: Option<FrictionLaw>,
+}
+
+/// A torque `magnitude·axis·STEP(t, 0, 0, ramp, 1)` on a body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorqueLoad {
+    /// Body index.
+    pub body: usize,
+    /// Unit axis, world frame.
+    pub axis: Vec3,
+    /// Signed magnitude [N·m].
+    pub magnitude: f64,
+    /// Ramp [s].
+    pub ramp: f64,
+}
+
+impl TorqueLoad {
+    /// Torque vector at time t [N·m].
+    pub fn torque(&self, t: f64) -> Vec3 {
+        let s = if self.ramp <= 0.0 {
+            1.0
+        } else {
+            step(t, 0.0, 0.0, self.ramp, 1.0).0
+        };
+        self.axis * (self.magnitude * s)
+    }
+}
+
+/// What the recorder keeps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordPlan {
+    /// Tables to produce, in order.
+    pub tables: Vec<TableKind>,
+    /// Body indices recorded in `bodies`.
+    pub bodies: Vec<usize>,
+    /// Pair indices recorded in `contacts`.
+    pub pairs: Vec<usize>,
+}
+
+/// Read-only after assembly.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// Bodies; index = body id.
+    pub bodies: Vec<Body>,
+    /// Indices of the integrated bodies.
+    pub integrated: Vec<usize>,
+    /// Declared contact pairs; no other pair is evaluated.
+    pub pairs: Vec<ContactPair>,
+    /// Applied torques.
+    pub torques: Vec<TorqueLoad>,
+    /// Gravity [m/s²], world frame.
+    pub gravity: Vec3,
+    /// Integrator.
+    pub integrator: IntegratorKind,
+    /// Integrator step [s].
+    pub dt: f64,
+    /// Steps per recorded frame.
+    pub steps_per_output: u64,
+    /// Total steps.
+    pub total_steps: u64,
+    /// Recording plan.
+    pub record: RecordPlan,
+    /// Scene name.
+    pub name: String,
+}
+
+impl Model {
+    /// Simulated duration [s].
+    pub fn duration(&self) -> f64 {
+        self.total_steps as f64 * self.dt
+    }
+
+    /// Sets the prescribed bodies' pose and velocity at time `t`.
+    pub fn prescribe(&self, t: f64, state: &mut State) {
+        for (i, b) in self.bodies.iter().enumerate() {
+            if let Motion::KinematicSpin(p) = b.motion {
+                let q = Quat::from_scaled_axis(p.axis * p.angle(t)) * b.initial_rotation;
+                state.rot[i] = q;
+                state.omega[i] = q.inverse() * (p.axis * p.speed_at(t));
+            }
+        }
+    }
+}
+
+/// Mutable state: cheap to clone, so integrator stages copy it.
+///
+/// All arrays are indexed by body id; fixed bodies keep their initial values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// Time [s].
+    pub t: f64,
+    /// Centre-of-mass positions [m], world frame.
+    pub pos: Vec<Vec3>,
+    /// Orientations, body → world.
+    pub rot: Vec<Quat>,
+    /// Linear velocities [m/s], world frame.
+    pub vel: Vec<Vec3>,
+    /// Angular velocities [rad/s], **body frame**.
+    pub omega: Vec<Vec3>,
+}
+
+impl State {
+    /// Angular velocity of body `i` in the world frame [rad/s].
+    pub fn omega_world(&self, i: usize) -> Vec3 {
+        self.rot[i] * self.omega[i]
+    }
+
+    /// Velocity of the material point of body `i` at world point `p` [m/s].
+    pub fn point_velocity(&self, i: usize, p: &Vec3) -> Vec3 {
+        self.vel[i] + self.omega_world(i).cross(&(p - self.pos[i]))
+    }
+}

@@ -1,0 +1,79 @@
+//! Arrow tables from recorded buffers, with the one schema of [`crate::record`].
+//!
+//! Numeric buffers move into Arrow arrays without copying.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use arrow_array::types::UInt32Type;
+use arrow_array::{
+    ArrayRef, DictionaryArray, Float64Array, RecordBatch, StringArray, UInt32Array, UInt64Array,
+};
+use arrow_schema::{ArrowError, DataType, Field, Schema};
+
+use crate::record::{ColumnData, ColumnKind, Recording, TableBuffer, columns};
+use crate::scene::TableKind;
+
+/// Arrow schema of a table, with `unit` and `description` in each field's metadata.
+pub fn schema(table: TableKind, metadata: HashMap<String, String>) -> Schema {
+    let fields: Vec<Field> = columns(table)
+        .iter()
+        .map(|c| {
+            let dt = match c.kind {
+                ColumnKind::U64 => DataType::UInt64,
+                ColumnKind::U32 => DataType::UInt32,
+                ColumnKind::F64 => DataType::Float64,
+                ColumnKind::Name(_) => {
+                    DataType::Dictionary(Box::new(DataType::UInt32), Box::new(DataType::Utf8))
+                }
+            };
+            let mut md = HashMap::new();
+            md.insert("unit".to_string(), c.unit.to_string());
+            md.insert("description".to_string(), c.description.to_string());
+            Field::new(c.name, dt, false).with_metadata(md)
+        })
+        .collect();
+    Schema::new_with_metadata(fields, metadata)
+}
+
+/// One record batch per recorded table, with the run metadata on each schema.
+pub fn record_batches(rec: Recording) -> Result<Vec<(TableKind, RecordBatch)>, ArrowError> {
+    let metadata: HashMap<String, String> = rec.metadata.iter().cloned().collect();
+    let dict_values =
+        |names: &[String]| -> ArrayRef { Arc::new(StringArray::from_iter_values(names.iter())) };
+    let bodies = dict_values(&rec.body_names);
+    let pairs = dict_values(&rec.pair_names);
+    let mut out = Vec::with_capacity(rec.tables.len());
+    for TableBuffer { kind, data, .. } in rec.tables {
+        let schema = Arc::new(schema(kind, metadata.clone()));
+        let arrays = columns(kind)
+            .iter()
+            .zip(data)
+            .map(|(c, d)| -> Result<ArrayRef, ArrowError> {
+                Ok(match (c.kind, d) {
+                    (ColumnKind::U64, ColumnData::U64(v)) => Arc::new(UInt64Array::from(v)),
+                    (ColumnKind::U32, ColumnData::U32(v)) => Arc::new(UInt32Array::from(v)),
+                    (ColumnKind::F64, ColumnData::F64(v)) => Arc::new(Float64Array::from(v)),
+                    (ColumnKind::Name(dict), ColumnData::U32(v)) => {
+                        let values = match dict {
+                            crate::record::Dictionary::Bodies => bodies.clone(),
+                            crate::record::Dictionary::Pairs => pairs.clone(),
+                        };
+                        Arc::new(DictionaryArray::<UInt32Type>::try_new(
+                            UInt32Array::from(v),
+                            values,
+                        )?)
+                    }
+                    (k, _) => {
+                        return Err(ArrowError::SchemaError(format!(
+                            "column {} ({k:?}) has mismatched data",
+                            c.name
+                        )));
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        out.push((kind, RecordBatch::try_new(schema, arrays)?));
+    }
+    Ok(out)
+}

@@ -1,0 +1,351 @@
+//! What the user asks for: plain serde data, no physics.
+//!
+//! A scene is read from TOML text or from any serde value (the Python binding
+//! passes a dict), optionally patched with `dotted.key=value` overrides, then
+//! validated here, in one place. Every error names the field
+//! ([`SceneError::path`]). All quantities are SI unless a field says otherwise;
+//! the only non-SI input is a normal law declared with `units = "N-mm-s"`
+//! (the paper's field units), converted once in [`NormalLawSpec::to_law`].
+
+mod body;
+mod contact;
+mod load;
+mod overrides;
+
+pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
+pub use contact::{ContactSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
+pub use load::LoadSpec;
+pub use overrides::apply_override;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SceneError;
+
+/// Which fixed-step integrator advances the state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum IntegratorKind {
+    /// Semi-implicit (symplectic) Euler: velocities first, then positions
+    /// with the new velocities; quaternions by the exact exponential map.
+    /// First order, one force evaluation per step.
+    SymplecticEuler,
+    /// Classical fourth-order Runge–Kutta; rotations by Runge–Kutta–Munthe-Kaas
+    /// on the rotation vector, so quaternions stay on the manifold.
+    /// Four force evaluations per step.
+    #[default]
+    Rk4,
+}
+
+impl IntegratorKind {
+    /// The name used in scene files and output metadata.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::SymplecticEuler => "symplectic-euler",
+            Self::Rk4 => "rk4",
+        }
+    }
+}
+
+/// Time stepping.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Simulated duration [s].
+    pub duration: f64,
+    /// Integrator step [s].
+    pub dt: f64,
+    /// Interval between recorded frames [s]; an integer multiple of `dt`.
+    pub output_interval: f64,
+    /// Integrator.
+    #[serde(default)]
+    pub integrator: IntegratorKind,
+}
+
+/// Global fields.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldSpec {
+    /// Gravitational acceleration [m/s²], world frame.
+    #[serde(default)]
+    pub gravity: [f64; 3],
+}
+
+impl Default for WorldSpec {
+    fn default() -> Self {
+        Self { gravity: [0.0; 3] }
+    }
+}
+
+/// Output tables a scene can ask for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TableKind {
+    /// Body poses and velocities, one row per recorded body per frame.
+    Bodies,
+    /// Contact points in contact, one row per point per frame.
+    Contacts,
+    /// Energy balance per frame.
+    Energy,
+}
+
+impl TableKind {
+    /// Table name, also the Parquet file stem.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bodies => "bodies",
+            Self::Contacts => "contacts",
+            Self::Energy => "energy",
+        }
+    }
+}
+
+/// What to record. Nothing else is computed for output.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordSpec {
+    /// Tables to produce.
+    #[serde(default = "default_tables")]
+    pub tables: Vec<TableKind>,
+    /// Bodies recorded in `bodies`; empty means every non-fixed body.
+    #[serde(default)]
+    pub bodies: Vec<String>,
+    /// Contact pairs recorded in `contacts`; empty means every pair.
+    #[serde(default)]
+    pub contacts: Vec<String>,
+}
+
+fn default_tables() -> Vec<TableKind> {
+    vec![TableKind::Bodies, TableKind::Contacts]
+}
+
+impl Default for RecordSpec {
+    fn default() -> Self {
+        Self {
+            tables: default_tables(),
+            bodies: vec![],
+            contacts: vec![],
+        }
+    }
+}
+
+/// A complete scene: bodies, contacts, loads, time stepping and recording.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Free-form scene name, copied into the output metadata.
+    #[serde(default)]
+    pub name: String,
+    /// Time stepping.
+    pub simulation: SimulationSpec,
+    /// Gravity.
+    #[serde(default)]
+    pub world: WorldSpec,
+    /// What to record.
+    #[serde(default)]
+    pub record: RecordSpec,
+    /// Bodies, in order; the order fixes body ids.
+    pub bodies: Vec<BodySpec>,
+    /// Declared contact pairs; no other pair is ever tested.
+    #[serde(default)]
+    pub contacts: Vec<ContactSpec>,
+    /// Applied loads.
+    #[serde(default)]
+    pub loads: Vec<LoadSpec>,
+}
+
+impl Scene {
+    /// Parses TOML text, applies `dotted.key=value` overrides, and validates.
+    pub fn from_toml_str(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            SceneError::new(toml_error_path(&e, text), "", first_line(e.message()))
+        })?;
+        Self::from_table(table, overrides)
+    }
+
+    /// Builds a scene from a TOML table (any serde source converts to one),
+    /// applies overrides, deserializes with field paths, and validates.
+    pub fn from_table(table: toml::Table, overrides: &[String]) -> Result<Self, SceneError> {
+        let mut root = toml::Value::Table(table);
+        for o in overrides {
+            apply_override(&mut root, o)?;
+        }
+        let scene: Scene = serde_path_to_error::deserialize(root).map_err(|e| {
+            let path = e.path().to_string();
+            SceneError::new(
+                if path == "." { String::new() } else { path },
+                "",
+                first_line(&e.into_inner().to_string()),
+            )
+        })?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// The scene as TOML, with every default written out.
+    pub fn to_toml(&self) -> String {
+        // Serializing plain data with finite numbers cannot fail.
+        toml::to_string_pretty(self)
+            .unwrap_or_else(|e| format!("# scene could not be written: {e}\n"))
+    }
+
+    /// Index of the body named `name`.
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.bodies.iter().position(|b| b.name == name)
+    }
+
+    /// Checks every value; the first problem found is returned with its path.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        let s = &self.simulation;
+        positive("simulation.duration", s.duration)?;
+        positive("simulation.dt", s.dt)?;
+        positive("simulation.output_interval", s.output_interval)?;
+        if s.dt > s.duration {
+            return Err(SceneError::new(
+                "simulation.dt",
+                s.dt,
+                format!("step longer than the duration {} s", s.duration),
+            ));
+        }
+        let ratio = s.output_interval / s.dt;
+        if (ratio - ratio.round()).abs() > 1e-6 * ratio.max(1.0) || ratio.round() < 1.0 {
+            return Err(SceneError::new(
+                "simulation.output_interval",
+                s.output_interval,
+                format!(
+                    "must be a whole multiple (≥ 1) of simulation.dt = {} s",
+                    s.dt
+                ),
+            ));
+        }
+        finite_vec("world.gravity", &self.world.gravity)?;
+        if self.bodies.is_empty() {
+            return Err(SceneError::new(
+                "bodies",
+                "[]",
+                "a scene needs at least one body",
+            ));
+        }
+        for (i, b) in self.bodies.iter().enumerate() {
+            b.validate(&format!("bodies[{i}]"))?;
+            if self.bodies[..i].iter().any(|o| o.name == b.name) {
+                return Err(SceneError::new(
+                    format!("bodies[{i}].name"),
+                    &b.name,
+                    "duplicate body name",
+                ));
+            }
+        }
+        for (i, c) in self.contacts.iter().enumerate() {
+            c.validate(&format!("contacts[{i}]"), self)?;
+        }
+        let names: Vec<String> = self.contacts.iter().map(|c| c.pair_name()).collect();
+        for (i, n) in names.iter().enumerate() {
+            if names[..i].contains(n) {
+                return Err(SceneError::new(
+                    format!("contacts[{i}].name"),
+                    n,
+                    "duplicate contact pair name",
+                ));
+            }
+        }
+        for (i, l) in self.loads.iter().enumerate() {
+            l.validate(&format!("loads[{i}]"), self)?;
+        }
+        for (i, n) in self.record.bodies.iter().enumerate() {
+            if self.body_index(n).is_none() {
+                return Err(SceneError::new(
+                    format!("record.bodies[{i}]"),
+                    n,
+                    "no body of that name",
+                ));
+            }
+        }
+        for (i, n) in self.record.contacts.iter().enumerate() {
+            if !names.contains(n) {
+                return Err(SceneError::new(
+                    format!("record.contacts[{i}]"),
+                    n,
+                    "no contact pair of that name",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of integrator steps per recorded frame.
+    pub fn steps_per_output(&self) -> u64 {
+        (self.simulation.output_interval / self.simulation.dt).round() as u64
+    }
+
+    /// Total number of integrator steps.
+    pub fn total_steps(&self) -> u64 {
+        let n = (self.simulation.duration / self.simulation.dt).round() as u64;
+        n.max(1)
+    }
+}
+
+fn first_line(s: &str) -> String {
+    s.lines().next().unwrap_or("").trim().to_string()
+}
+
+fn toml_error_path(e: &toml::de::Error, text: &str) -> String {
+    match e.span() {
+        Some(span) => {
+            let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
+            format!("<toml line {line}>")
+        }
+        None => "<toml>".to_string(),
+    }
+}
+
+/// Rejects non-finite and non-positive values.
+pub(crate) fn positive(path: &str, v: f64) -> Result<(), SceneError> {
+    if !v.is_finite() {
+        return Err(SceneError::new(path, v, "must be a finite number"));
+    }
+    if v <= 0.0 {
+        return Err(SceneError::new(path, v, "must be positive"));
+    }
+    Ok(())
+}
+
+/// Rejects non-finite and negative values.
+pub(crate) fn non_negative(path: &str, v: f64) -> Result<(), SceneError> {
+    if !v.is_finite() {
+        return Err(SceneError::new(path, v, "must be a finite number"));
+    }
+    if v < 0.0 {
+        return Err(SceneError::new(path, v, "must not be negative"));
+    }
+    Ok(())
+}
+
+/// Rejects non-finite values.
+pub(crate) fn finite(path: &str, v: f64) -> Result<(), SceneError> {
+    if !v.is_finite() {
+        return Err(SceneError::new(path, v, "must be a finite number"));
+    }
+    Ok(())
+}
+
+/// Rejects vectors with a non-finite component.
+pub(crate) fn finite_vec(path: &str, v: &[f64]) -> Result<(), SceneError> {
+    for (i, x) in v.iter().enumerate() {
+        finite(&format!("{path}[{i}]"), *x)?;
+    }
+    Ok(())
+}
+
+/// Rejects vectors that are not finite or have (near) zero length.
+pub(crate) fn direction(path: &str, v: &[f64; 3]) -> Result<(), SceneError> {
+    finite_vec(path, v)?;
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if n < 1e-12 {
+        return Err(SceneError::new(
+            path,
+            format!("{v:?}"),
+            "must be a non-zero direction",
+        ));
+    }
+    Ok(())
+}

@@ -1,0 +1,239 @@
+//! PyO3 glue for `ballcage._native`: no physics here.
+//!
+//! Scenes are validated in Rust only; runs release the GIL; tables cross to
+//! pyarrow zero-copy through the Arrow PyCapsule interface (pyo3-arrow).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use ballcage_core::scene::TableKind;
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use pyo3_arrow::{PySchema, PyTable};
+
+create_exception!(
+    _native,
+    SceneError,
+    PyValueError,
+    "A scene field is missing or invalid; `.path` names it."
+);
+create_exception!(
+    _native,
+    SimulationError,
+    PyRuntimeError,
+    "A run stopped because its state stopped being physical."
+);
+
+fn scene_err(py: Python<'_>, e: ballcage_core::SceneError) -> PyErr {
+    let err = SceneError::new_err(e.to_string());
+    let value = err.value(py);
+    // Attributes for programmatic access; setting them on a fresh exception cannot fail in practice.
+    let _ = value.setattr("path", e.path.clone());
+    let _ = value.setattr("value", e.value.clone());
+    let _ = value.setattr("reason", e.reason.clone());
+    err
+}
+
+fn sim_err(e: ballcage_core::SimulationError) -> PyErr {
+    SimulationError::new_err(e.to_string())
+}
+
+/// A validated scene.
+#[pyclass(module = "ballcage._native", frozen)]
+struct Scene {
+    inner: ballcage_core::Scene,
+}
+
+#[pymethods]
+impl Scene {
+    /// Parses and validates TOML text, after applying `key=value` overrides.
+    #[staticmethod]
+    #[pyo3(signature = (text, overrides = Vec::new()))]
+    fn from_toml(py: Python<'_>, text: &str, overrides: Vec<String>) -> PyResult<Self> {
+        ballcage_core::Scene::from_toml_str(text, &overrides)
+            .map(|inner| Self { inner })
+            .map_err(|e| scene_err(py, e))
+    }
+
+    /// Validates a dict with the structure of a TOML scene.
+    #[staticmethod]
+    #[pyo3(signature = (obj, overrides = Vec::new()))]
+    fn from_dict(
+        py: Python<'_>,
+        obj: &Bound<'_, PyDict>,
+        overrides: Vec<String>,
+    ) -> PyResult<Self> {
+        let table: toml::Table = pythonize::depythonize(obj.as_any()).map_err(|e| {
+            scene_err(
+                py,
+                ballcage_core::SceneError::new("", "", format!("not a scene table: {e}")),
+            )
+        })?;
+        ballcage_core::Scene::from_table(table, &overrides)
+            .map(|inner| Self { inner })
+            .map_err(|e| scene_err(py, e))
+    }
+
+    /// The resolved scene as TOML, every default written out.
+    fn to_toml(&self) -> String {
+        self.inner.to_toml()
+    }
+
+    /// Scene name.
+    #[getter]
+    fn name(&self) -> String {
+        self.inner.name.clone()
+    }
+
+    /// Simulated duration [s].
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.inner.simulation.duration
+    }
+
+    /// Integrator step [s].
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.inner.simulation.dt
+    }
+
+    /// Output interval [s].
+    #[getter]
+    fn output_interval(&self) -> f64 {
+        self.inner.simulation.output_interval
+    }
+
+    /// Integrator name.
+    #[getter]
+    fn integrator(&self) -> &'static str {
+        self.inner.simulation.integrator.name()
+    }
+
+    /// Names of the tables this scene records.
+    #[getter]
+    fn table_names(&self) -> Vec<&'static str> {
+        self.inner.record.tables.iter().map(|t| t.name()).collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene(name={:?}, bodies={}, contacts={}, duration={} s, dt={} s)",
+            self.inner.name,
+            self.inner.bodies.len(),
+            self.inner.contacts.len(),
+            self.inner.simulation.duration,
+            self.inner.simulation.dt
+        )
+    }
+}
+
+/// A running simulation.
+#[pyclass(module = "ballcage._native")]
+struct Simulation {
+    inner: Option<ballcage_core::Simulation>,
+}
+
+impl Simulation {
+    fn get(&self) -> PyResult<&ballcage_core::Simulation> {
+        self.inner.as_ref().ok_or_else(|| {
+            PyRuntimeError::new_err("the simulation was finished; its tables were handed over")
+        })
+    }
+}
+
+#[pymethods]
+impl Simulation {
+    #[new]
+    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
+        let sim = ballcage_core::Simulation::new(&scene.inner).map_err(|e| scene_err(py, e))?;
+        Ok(Self { inner: Some(sim) })
+    }
+
+    /// Simulated time reached [s].
+    #[getter]
+    fn time(&self) -> PyResult<f64> {
+        Ok(self.get()?.time())
+    }
+
+    /// Scene duration [s].
+    #[getter]
+    fn duration(&self) -> PyResult<f64> {
+        Ok(self.get()?.model().duration())
+    }
+
+    /// Integrator steps taken.
+    #[getter]
+    fn steps(&self) -> PyResult<u64> {
+        Ok(self.get()?.steps())
+    }
+
+    /// Runs until `t_end` [s] (clamped to the duration), without the GIL.
+    fn advance(&mut self, py: Python<'_>, t_end: f64) -> PyResult<()> {
+        if !t_end.is_finite() {
+            return Err(PyValueError::new_err(format!(
+                "t_end = {t_end}: must be a finite time in seconds"
+            )));
+        }
+        let sim = self
+            .inner
+            .as_mut()
+            .ok_or_else(|| PyRuntimeError::new_err("the simulation was finished"))?;
+        py.detach(|| sim.advance_to(t_end)).map_err(sim_err)
+    }
+
+    /// Ends the run: one `pyarrow.Table` per recorded table, by name.
+    fn finish<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sim = self
+            .inner
+            .take()
+            .ok_or_else(|| PyRuntimeError::new_err("finish() was already called"))?;
+        let batches = ballcage_core::output::record_batches(sim.finish())
+            .map_err(|e| PyRuntimeError::new_err(format!("building Arrow tables failed: {e}")))?;
+        let out = PyDict::new(py);
+        for (kind, batch) in batches {
+            let schema = batch.schema();
+            let table = PyTable::try_new(vec![batch], schema)?;
+            out.set_item(kind.name(), table.into_pyarrow(py)?)?;
+        }
+        Ok(out)
+    }
+}
+
+/// The Arrow schema of an output table (`bodies`, `contacts`, `energy`).
+#[pyfunction]
+fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    let kind = match name {
+        "bodies" => TableKind::Bodies,
+        "contacts" => TableKind::Contacts,
+        "energy" => TableKind::Energy,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "table `{name}`: unknown (tables are bodies, contacts, energy)"
+            )));
+        }
+    };
+    let schema = ballcage_core::output::schema(kind, HashMap::new());
+    PySchema::new(Arc::new(schema)).into_pyarrow(py)
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("__version__", ballcage_core::VERSION)?;
+    m.add(
+        "BUILD_PROFILE",
+        if cfg!(debug_assertions) {
+            "debug"
+        } else {
+            "release"
+        },
+    )?;
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    m.add_class::<Scene>()?;
+    m.add_class::<Simulation>()?;
+    m.add_function(wrap_pyfunction!(table_schema, m)?)?;
+    Ok(())
+}

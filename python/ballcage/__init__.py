@@ -1,0 +1,49 @@
+"""ballcage: rigid-body penalty-contact dynamics with Arrow/Parquet output.
+
+The pipeline is scene → simulation → tables::
+
+    import ballcage
+
+    run = ballcage.simulate("examples/scenes/ball_drop.toml")
+    run.bodies            # pyarrow.Table, one row per recorded body per frame
+    run.write("out/")     # out/bodies.parquet, out/contacts.parquet, out/scene.toml
+
+A scene is a TOML file, a dict of the same structure, or a `SceneBuilder`;
+`load_scene` validates it (in Rust) and raises `SceneError` naming the field.
+All quantities are SI; units are in each output column's field metadata.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+from ballcage import _native
+from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
+from ballcage.run import Run, simulate
+from ballcage.scene import SceneBuilder, load_scene
+
+__version__: str = _native.__version__
+
+__all__ = [
+    "Run",
+    "Scene",
+    "SceneBuilder",
+    "SceneError",
+    "Simulation",
+    "SimulationError",
+    "__version__",
+    "load_scene",
+    "simulate",
+    "table_schema",
+]
+
+DEBUG_BUILD_MESSAGE = "ballcage was built without optimizations; runs are ~10x slower: pip install . builds release"
+
+
+def _warn_if_debug_build(build_profile: str) -> None:
+    """Warns once, at import, when the extension was compiled without optimizations."""
+    if build_profile == "debug":
+        warnings.warn(DEBUG_BUILD_MESSAGE, RuntimeWarning, stacklevel=3)
+
+
+_warn_if_debug_build(_native.BUILD_PROFILE)

@@ -1,0 +1,237 @@
+"""Running a scene: `simulate` → `Run` (tables in memory) → `Run.write` (Parquet files).
+
+The simulation itself runs in Rust without the GIL. `simulate` advances it in
+about `CHUNKS` pieces so that Ctrl-C is honoured between pieces and a progress
+bar can be drawn; the chunking does not change the result (the integrator
+steps are the same).
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import sys
+import time
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, TextIO
+
+from ballcage import _native
+from ballcage.scene import SceneSource, load_scene
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+__all__ = ["Run", "simulate"]
+
+#: Number of `advance` calls a run is split into.
+CHUNKS = 200
+#: Wall time [s] after which an automatic progress bar appears.
+PROGRESS_DELAY_S = 1.5
+
+
+class Run:
+    """The recorded output of one simulation run.
+
+    `tables` maps each recorded table name (``"bodies"``, ``"contacts"``,
+    ``"energy"``) to a `pyarrow.Table`; units are in each field's metadata.
+    """
+
+    def __init__(self, tables: Mapping[str, pa.Table], scene_toml: str) -> None:
+        self.tables: dict[str, pa.Table] = dict(tables)
+        self._scene_toml = scene_toml
+
+    @property
+    def bodies(self) -> pa.Table:
+        """Body poses and velocities: one row per recorded body per frame."""
+        return self._table("bodies")
+
+    @property
+    def contacts(self) -> pa.Table:
+        """Contact points in contact: one row per point per frame."""
+        return self._table("contacts")
+
+    @property
+    def energy(self) -> pa.Table:
+        """Energy balance: one row per frame."""
+        return self._table("energy")
+
+    @property
+    def metadata(self) -> dict[str, str]:
+        """Run metadata (``ballcage.version``, ``ballcage.dt_s``, …), decoded from the table schemas."""
+        for table in self.tables.values():
+            raw = table.schema.metadata or {}
+            return {k.decode(): v.decode() for k, v in raw.items()}
+        return {}
+
+    @property
+    def scene_toml(self) -> str:
+        """The resolved scene as TOML, every default written out."""
+        return self._scene_toml
+
+    def write(self, directory: str | os.PathLike[str]) -> dict[str, Path]:
+        """Writes ``<table>.parquet`` (zstd) for every table and ``scene.toml`` into `directory`.
+
+        The directory is created if needed. Each file is written atomically:
+        a reader sees either the previous file or the complete new one, and a
+        failed write leaves no file under the final name and no temporary file.
+        Returns the written paths, keyed by table name and ``"scene"``.
+        """
+        import pyarrow.parquet as pq  # deferred: only writers pay for it
+
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        written: dict[str, Path] = {}
+        for name, table in self.tables.items():
+            path = out / f"{name}.parquet"
+            _write_atomically(path, lambda tmp, t=table: pq.write_table(t, str(tmp), compression="zstd"))
+            written[name] = path
+        scene_path = out / "scene.toml"
+        _write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
+        written["scene"] = scene_path
+        return written
+
+    def _table(self, name: str) -> pa.Table:
+        try:
+            return self.tables[name]
+        except KeyError:
+            recorded = ", ".join(self.tables) or "none"
+            raise KeyError(
+                f"the scene did not record the {name!r} table (recorded: {recorded}); "
+                f"ask for it in the scene's `record.tables`, e.g. tables = [\"bodies\", \"contacts\", \"energy\"] "
+                f"or overrides=['record.tables=[\"bodies\", \"contacts\", \"energy\"]']"
+            ) from None
+
+    def __repr__(self) -> str:
+        shapes = ", ".join(f"{n}: {t.num_rows} rows" for n, t in self.tables.items())
+        return f"<ballcage.Run {shapes}>"
+
+
+def simulate(
+    scene: SceneSource,
+    *,
+    overrides: Iterable[str] = (),
+    progress: bool | None = None,
+) -> Run:
+    """Runs a scene to its duration and returns the recorded tables.
+
+    `scene` is anything `load_scene` accepts; `overrides` are ``dotted.key=value``
+    strings. `progress`: ``None`` shows a bar on stderr once the run has taken
+    more than 1.5 s, ``True`` shows it from the start, ``False`` never.
+
+    Raises `ballcage.SceneError` for an invalid scene and
+    `ballcage.SimulationError` when the run diverges.
+    """
+    resolved = load_scene(scene, overrides)
+    sim = _native.Simulation(resolved)
+    duration = sim.duration
+    bar = _ProgressBar(progress, duration)
+    try:
+        for i in range(1, CHUNKS + 1):
+            sim.advance(duration if i == CHUNKS else duration * i / CHUNKS)
+            bar.update(sim.time)
+    finally:
+        bar.close()
+    return Run(sim.finish(), resolved.to_toml())
+
+
+class _ProgressBar:
+    """A dependency-free progress bar on stderr.
+
+    On a terminal it redraws one line with ``\\r``; otherwise (a log file, CI)
+    it prints a line at every 10 %.
+    """
+
+    WIDTH = 30
+
+    def __init__(
+        self,
+        mode: bool | None,
+        duration: float,
+        stream: TextIO | None = None,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self._mode = mode
+        self._duration = duration
+        self._stream = stream if stream is not None else sys.stderr
+        self._clock = clock
+        self._start = clock()
+        self._shown = False
+        self._tty = _isatty(self._stream)
+        self._last_decile = 0  # the first line is at 10 %
+
+    def update(self, t: float) -> None:
+        if self._mode is False:
+            return
+        elapsed = self._clock() - self._start
+        if not self._shown:
+            if self._mode is not True and elapsed <= PROGRESS_DELAY_S:
+                return
+            self._shown = True
+        fraction = min(max(t / self._duration, 0.0), 1.0) if self._duration > 0 else 1.0
+        if self._tty:
+            filled = round(fraction * self.WIDTH)
+            bar = "#" * filled + "." * (self.WIDTH - filled)
+            self._stream.write(
+                f"\rballcage: [{bar}] {fraction:4.0%}  t = {t:.4g} / {self._duration:.4g} s  {elapsed:.1f} s"
+            )
+            self._stream.flush()
+        else:
+            decile = int(fraction * 10 + 1e-9)
+            if decile > self._last_decile:
+                self._last_decile = decile
+                self._stream.write(
+                    f"ballcage: {decile * 10:3d}%  t = {t:.4g} / {self._duration:.4g} s  {elapsed:.1f} s\n"
+                )
+                self._stream.flush()
+
+    def close(self) -> None:
+        if self._shown and self._tty:
+            self._stream.write("\n")
+            self._stream.flush()
+
+
+def _isatty(stream: TextIO) -> bool:
+    try:
+        return stream.isatty()
+    except (AttributeError, ValueError):
+        return False
+
+
+def _write_atomically(final: Path, write: Callable[[Path], object]) -> None:
+    """Writes `final` through a hidden temporary file in the same directory.
+
+    `write(tmp)` fills the temporary file; it is then fsynced and renamed over
+    `final` (``os.replace``, atomic on POSIX and Windows). On any exception the
+    temporary file is removed and `final` is left as it was.
+    """
+    tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
+    # O_EXCL: never clobber another writer's temporary; mode 0o666 minus umask,
+    # the permissions a plain open() would give the final file.
+    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    try:
+        write(tmp)
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        os.replace(tmp, final)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    _fsync_directory(final.parent)
+
+
+def _fsync_directory(directory: Path) -> None:
+    """Makes a rename durable; a no-op where directories cannot be opened (Windows)."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)

@@ -1,0 +1,166 @@
+"""Scenes: load one from a file, a dict or a builder; validation happens in Rust.
+
+There is one way in for each kind of source:
+
+- a path (``str`` or ``os.PathLike``) to a TOML file,
+- a dict with the structure of the TOML file,
+- a `SceneBuilder`, which emits such a dict,
+- an already validated `ballcage.Scene`.
+
+Every route ends in the same Rust validator, so a scene written as TOML and
+the same scene built in Python produce bitwise identical runs.
+"""
+
+from __future__ import annotations
+
+import copy
+import errno
+import os
+from collections.abc import Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any, Self, TypeAlias
+
+from ballcage import _native
+
+__all__ = ["SceneBuilder", "SceneSource", "load_scene"]
+
+
+class SceneBuilder:
+    """A small fluent builder that emits a scene dict (see `to_dict`).
+
+    Each method records one part of the scene and returns the builder::
+
+        scene = (
+            SceneBuilder("ball drop")
+            .simulation(duration=0.2, dt=5e-5, output_interval=1e-3)
+            .gravity([0.0, 0.0, -9.81])
+            .body("ground", motion="fixed", shape={"type": "half-space", "normal": [0.0, 0.0, 1.0]})
+            .body("ball", shape={"type": "ball", "radius": 0.05}, mass=1.0, position=[0.0, 0.0, 0.1])
+            .contact("ground", "ball", normal={"law": "hertz", "stiffness": 1e8})
+        )
+
+    Field names and units are those of the TOML scene format (SI). Nothing is
+    checked here: `load_scene` validates the dict in Rust.
+    """
+
+    def __init__(self, name: str = "") -> None:
+        self._scene: dict[str, Any] = {"name": name, "simulation": {}, "bodies": []}
+
+    def simulation(
+        self,
+        *,
+        duration: float | None = None,
+        dt: float | None = None,
+        output_interval: float | None = None,
+        integrator: str | None = None,
+    ) -> Self:
+        """Time stepping: `duration`, `dt` and `output_interval` [s], `integrator` name."""
+        given = {"duration": duration, "dt": dt, "output_interval": output_interval, "integrator": integrator}
+        self._scene["simulation"].update({k: v for k, v in given.items() if v is not None})
+        return self
+
+    def gravity(self, gravity: Sequence[float]) -> Self:
+        """Gravitational acceleration [m/s²], world frame."""
+        self._scene.setdefault("world", {})["gravity"] = _plain(gravity)
+        return self
+
+    def body(self, name: str, *, shape: Mapping[str, Any], **fields: Any) -> Self:
+        """A body: `shape` (a dict with ``type``) and any other body field (`mass`, `position`, …)."""
+        self._scene["bodies"].append({"name": name, "shape": _plain(shape), **_plain(fields)})
+        return self
+
+    def contact(
+        self,
+        a: str,
+        b: str,
+        *,
+        normal: Mapping[str, Any],
+        friction: Mapping[str, Any] | None = None,
+        **fields: Any,
+    ) -> Self:
+        """A contact pair between bodies `a` and `b` with a `normal` law (a dict with ``law``)."""
+        spec: dict[str, Any] = {"bodies": [a, b], "normal": _plain(normal)}
+        if friction is not None:
+            spec["friction"] = _plain(friction)
+        spec.update(_plain(fields))
+        self._scene.setdefault("contacts", []).append(spec)
+        return self
+
+    def torque(self, body: str, axis: Sequence[float], magnitude: float, *, ramp: float = 0.0) -> Self:
+        """A torque `magnitude`·`axis` [N·m] on `body`, ramped in over `ramp` [s]."""
+        load = {"type": "torque", "body": body, "axis": _plain(axis), "magnitude": magnitude, "ramp": ramp}
+        self._scene.setdefault("loads", []).append(load)
+        return self
+
+    def record(
+        self,
+        *,
+        tables: Sequence[str] | None = None,
+        bodies: Sequence[str] | None = None,
+        contacts: Sequence[str] | None = None,
+    ) -> Self:
+        """What to record: table names, and optionally which bodies and contact pairs."""
+        given = {"tables": tables, "bodies": bodies, "contacts": contacts}
+        self._scene.setdefault("record", {}).update({k: _plain(v) for k, v in given.items() if v is not None})
+        return self
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene as a plain dict (a deep copy), ready for `load_scene`."""
+        return copy.deepcopy(self._scene)
+
+    def __repr__(self) -> str:
+        return f"SceneBuilder({self._scene.get('name', '')!r}, bodies={len(self._scene['bodies'])})"
+
+
+SceneSource: TypeAlias = "str | os.PathLike[str] | Mapping[str, Any] | SceneBuilder | _native.Scene"
+
+
+def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Scene:
+    """Reads and validates a scene.
+
+    `source` is a path to a TOML file, a dict of the same structure, a
+    `SceneBuilder` or a `ballcage.Scene`. `overrides` are ``dotted.key=value``
+    strings applied before validation (``"bodies.1.mass=2"``; the value is
+    parsed as TOML).
+
+    Raises `ballcage.SceneError` (naming the field) for an invalid scene and
+    `FileNotFoundError` (naming the path) for a missing file.
+    """
+    if isinstance(overrides, str):
+        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+    patches = list(overrides)
+    if isinstance(source, _native.Scene):
+        return _native.Scene.from_toml(source.to_toml(), patches) if patches else source
+    if isinstance(source, SceneBuilder):
+        return _native.Scene.from_dict(source.to_dict(), patches)
+    if isinstance(source, Mapping):
+        return _native.Scene.from_dict(_plain(source), patches)
+    if isinstance(source, (str, os.PathLike)):
+        return _native.Scene.from_toml(_read_scene_file(source), patches)
+    raise TypeError(
+        f"cannot load a scene from {type(source).__name__}: give a path to a TOML file, "
+        "a dict, a SceneBuilder or a ballcage.Scene"
+    )
+
+
+def _read_scene_file(source: str | os.PathLike[str]) -> str:
+    if isinstance(source, str) and "\n" in source:
+        raise ValueError("load_scene takes a path, not TOML text: use ballcage.Scene.from_toml(text)")
+    path = Path(source)
+    try:
+        return path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileNotFoundError(errno.ENOENT, "scene file not found", str(path)) from None
+
+
+def _plain(value: Any) -> Any:
+    """Deep-copies mappings to dicts and other sequences (tuples, arrays) to lists."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (str, bytes)):
+        return value
+    if isinstance(value, Sequence):
+        return [_plain(v) for v in value]
+    if hasattr(value, "tolist"):  # numpy arrays and scalars
+        return _plain(value.tolist())
+    return value

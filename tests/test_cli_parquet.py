@@ -1,0 +1,158 @@
+"""`ballcage run` writes Parquet + scene.toml identical to simulate(); writes are atomic."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+import ballcage
+
+BALL_DROP = Path(__file__).resolve().parent.parent / "examples" / "scenes" / "ball_drop.toml"
+WALL_TIME = b"ballcage.wall_time_s"
+METADATA_KEYS = {
+    b"ballcage.scene",
+    b"ballcage.version",
+    b"ballcage.integrator",
+    b"ballcage.dt_s",
+    b"ballcage.wall_time_s",
+    b"ballcage.complete",
+}
+
+
+def _cli(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "ballcage", *args], capture_output=True, text=True, timeout=120)
+
+
+def _without_wall_time(table):
+    meta = {k: v for k, v in (table.schema.metadata or {}).items() if k != WALL_TIME}
+    return table.replace_schema_metadata(meta)
+
+
+@pytest.fixture(scope="module")
+def cli_out(tmp_path_factory):
+    out = tmp_path_factory.mktemp("run") / "out"
+    proc = _cli("run", str(BALL_DROP), "--out", str(out))
+    assert proc.returncode == 0, proc.stderr
+    return out, proc
+
+
+def test_cli_run_writes_tables_and_scene_and_summarises_each(cli_out):
+    out, proc = cli_out
+    assert sorted(p.name for p in out.iterdir()) == ["bodies.parquet", "contacts.parquet", "scene.toml"]
+    lines = proc.stdout.splitlines()
+    assert len(lines) == 3
+    for name, line in zip(["bodies.parquet", "contacts.parquet", "scene.toml"], lines, strict=True):
+        assert name in line
+    assert "rows" in lines[0]
+    assert proc.stderr == ""  # a 0.2 s scene is too quick for a progress bar
+
+
+def test_parquet_files_equal_the_in_memory_tables(cli_out, ball_drop_path):
+    out, _ = cli_out
+    run = ballcage.simulate(ball_drop_path)
+    assert run.contacts.num_rows > 0
+    for name, table in run.tables.items():
+        read = pq.read_table(out / f"{name}.parquet")
+        assert read.equals(table), name
+        # Field metadata (units) and run metadata survive, except the wall time.
+        assert _without_wall_time(read).schema.equals(_without_wall_time(table).schema, check_metadata=True), name
+        assert METADATA_KEYS <= set(read.schema.metadata), name
+        assert float(read.schema.metadata[WALL_TIME]) >= 0.0
+        assert read.schema.metadata[b"ballcage.complete"] == b"true"
+    assert pq.read_table(out / "bodies.parquet").schema.field("pos_z").metadata[b"unit"] == b"m"
+    assert pq.read_table(out / "contacts.parquet").schema.field("normal_force").metadata[b"unit"] == b"N"
+
+
+def test_written_scene_toml_loads_and_is_the_resolved_scene(cli_out, ball_drop_path):
+    out, _ = cli_out
+    text = (out / "scene.toml").read_text(encoding="utf-8")
+    assert text == ballcage.load_scene(ball_drop_path).to_toml()
+    assert ballcage.load_scene(out / "scene.toml").to_toml() == text
+    assert pq.read_table(out / "bodies.parquet").schema.metadata[b"ballcage.scene"].decode() == text
+
+
+def test_cli_set_overrides_the_scene(tmp_path, ball_drop_path):
+    out = tmp_path / "short"
+    proc = _cli("run", str(ball_drop_path), "--out", str(out), "--set", "simulation.duration=0.05", "--quiet")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout == "" and proc.stderr == ""
+    assert pq.read_table(out / "bodies.parquet").num_rows == round(0.05 / 1e-3) + 1
+    assert tomllib.loads((out / "scene.toml").read_text(encoding="utf-8"))["simulation"]["duration"] == 0.05
+
+
+def test_cli_schema_prints_units_and_descriptions():
+    proc = _cli("schema", "bodies")
+    assert proc.returncode == 0, proc.stderr
+    schema = ballcage.table_schema("bodies")
+    lines = proc.stdout.splitlines()
+    assert lines[0] == "bodies"
+    assert len(lines) == 1 + len(schema)
+    pos_z = next(line for line in lines if line.split()[0] == "pos_z")
+    assert "[m]" in pos_z
+    assert schema.field("pos_z").metadata[b"description"].decode() in pos_z
+    every = _cli("schema")
+    assert every.returncode == 0
+    assert [line for line in every.stdout.splitlines() if line and not line.startswith(" ")] == [
+        "bodies", "contacts", "energy",
+    ]
+
+
+def _run_small(ball_drop_path):
+    return ballcage.simulate(ball_drop_path, overrides=["simulation.duration=0.01"])
+
+
+def _leftovers(directory):
+    return sorted(p.name for p in directory.iterdir() if p.name.startswith(".") or p.name.endswith(".tmp"))
+
+
+def test_failed_parquet_write_leaves_no_file_and_no_temporary(tmp_path, ball_drop_path, monkeypatch):
+    run = _run_small(ball_drop_path)
+    real_write_table = pq.write_table
+
+    def write_half_then_fail(table, where, **kwargs):
+        real_write_table(table.slice(0, 1), where, **kwargs)  # something is on disk...
+        raise OSError("disk full")  # ...then the write fails midway
+
+    monkeypatch.setattr(pq, "write_table", write_half_then_fail)
+    out = tmp_path / "out"
+    with pytest.raises(OSError, match="disk full"):
+        run.write(out)
+    assert not (out / "bodies.parquet").exists()
+    assert _leftovers(out) == []
+
+
+def test_failed_write_keeps_the_previous_file_intact(tmp_path, ball_drop_path, monkeypatch):
+    run = _run_small(ball_drop_path)
+    out = tmp_path / "out"
+    run.write(out)
+    before = (out / "bodies.parquet").read_bytes()
+
+    def fail(table, where, **kwargs):
+        with open(where, "wb") as f:
+            f.write(b"PAR1 truncated")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pq, "write_table", fail)
+    with pytest.raises(KeyboardInterrupt):
+        ballcage.simulate(ball_drop_path, overrides=["simulation.duration=0.02"]).write(out)
+    assert (out / "bodies.parquet").read_bytes() == before
+    assert _leftovers(out) == []
+
+
+def test_write_returns_the_paths_and_creates_the_directory(tmp_path, ball_drop_path):
+    run = _run_small(ball_drop_path)
+    out = tmp_path / "a" / "b"
+    paths = run.write(out)
+    assert paths == {
+        "bodies": out / "bodies.parquet",
+        "contacts": out / "contacts.parquet",
+        "scene": out / "scene.toml",
+    }
+    assert all(p.is_file() for p in paths.values())
+    assert _leftovers(out) == []
+    assert pq.read_table(paths["bodies"]).equals(run.bodies)
