@@ -123,7 +123,7 @@ impl Simulation {
         self.step += 1;
         self.state.t = self.step as f64 * h;
         self.check_finite()?;
-        if self.step % self.model.steps_per_output == 0 {
+        if self.step.is_multiple_of(self.model.steps_per_output) {
             self.record_frame();
         }
         Ok(())

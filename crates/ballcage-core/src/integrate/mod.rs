@@ -69,7 +69,7 @@ fn symplectic_euler(
         state.vel[i] += h * acc.lin[i];
         state.omega[i] += h * acc.ang[i];
         state.pos[i] += h * state.vel[i];
-        state.rot[i] = state.rot[i] * exp_map(&(h * state.omega[i]));
+        state.rot[i] *= exp_map(&(h * state.omega[i]));
         state.rot[i].renormalize_fast();
     }
     state.t += h;
@@ -121,7 +121,7 @@ fn rk4(model: &Model, dynamics: &mut Dynamics, ws: &mut Workspace, state: &mut S
         state.pos[i] += h * dx;
         state.vel[i] += h * dv;
         state.omega[i] += h * dw;
-        state.rot[i] = state.rot[i] * exp_map(&(h * xi));
+        state.rot[i] *= exp_map(&(h * xi));
         state.rot[i].renormalize_fast();
     }
     state.t += h;

@@ -170,12 +170,23 @@ impl Scene {
             apply_override(&mut root, o)?;
         }
         let scene: Scene = serde_path_to_error::deserialize(root).map_err(|e| {
-            let path = e.path().to_string();
-            SceneError::new(
-                if path == "." { String::new() } else { path },
-                "",
-                first_line(&e.into_inner().to_string()),
-            )
+            let mut path = e.path().to_string();
+            if path == "." {
+                path.clear();
+            }
+            let reason = first_line(&e.into_inner().to_string());
+            // serde reports a missing field at its parent: name the field itself.
+            if let Some(field) = reason
+                .strip_prefix("missing field `")
+                .and_then(|r| r.split('`').next())
+            {
+                path = if path.is_empty() {
+                    field.to_string()
+                } else {
+                    format!("{path}.{field}")
+                };
+            }
+            SceneError::new(path, "", reason)
         })?;
         scene.validate()?;
         Ok(scene)
