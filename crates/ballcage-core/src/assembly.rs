@@ -1,7 +1,7 @@
 //! Scene → model and initial state, keeping only what the scene declares.
 
 use crate::error::SceneError;
-use crate::geometry::{PairGeometry, Shape};
+use crate::geometry::Shape;
 use crate::math::{Quat, Vec3};
 use crate::model::{Body, ContactPair, Model, Motion, RecordPlan, SpinProfile, State, TorqueLoad};
 use crate::scene::{LoadSpec, MotionKind, Scene};
@@ -70,18 +70,7 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
                 "no body of that name",
             )
         })?;
-        let (geometry, swapped) = PairGeometry::select_with_points(
-            &scene.bodies[a].shape,
-            &scene.bodies[b].shape,
-            c.points,
-        )
-        .ok_or_else(|| {
-            SceneError::new(
-                format!("{path}.bodies"),
-                format!("{:?}", c.bodies),
-                "unsupported pair",
-            )
-        })?;
+        let (geometry, swapped) = c.resolve_geometry(&path, scene)?;
         pairs.push(ContactPair {
             name: c.pair_name(),
             a,

@@ -16,6 +16,7 @@
 //! the scene (see [`scene::FieldUnits`]).
 
 pub mod assembly;
+pub mod drillpipe;
 pub mod dynamics;
 pub mod error;
 pub mod force;

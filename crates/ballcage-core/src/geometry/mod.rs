@@ -94,7 +94,7 @@ pub struct ContactPoint {
 }
 
 /// How a pair's contact points are found; chosen once, at assembly.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum PairGeometry {
     /// parry's convex–convex query, one deepest point (ball–half-space, ball–ball, ball–cuboid).
     ParryConvex,
@@ -107,6 +107,41 @@ pub enum PairGeometry {
     },
     /// Ball inside a tube.
     BallTube,
+    /// Ball (b) inside the tube of a torus on body a (a groove flank); vectors in a's frame.
+    TorusBall {
+        /// Core-circle centre [m].
+        centre: Vec3,
+        /// Unit normal of the core circle's plane.
+        axis: Vec3,
+        /// Core-circle radius [m].
+        core_radius: f64,
+        /// Section radius [m].
+        tube_radius: f64,
+        /// Radius of ball b [m].
+        ball_radius: f64,
+    },
+    /// Ball (b) between two parallel planes of body a; vectors in a's frame.
+    SlotBall {
+        /// Mid-plane point [m].
+        centre: Vec3,
+        /// Unit plane normal.
+        normal: Vec3,
+        /// Half-gap [m].
+        half_width: f64,
+        /// Radius of ball b [m].
+        ball_radius: f64,
+    },
+    /// Sphere on body b inside a spherical cavity of body a.
+    CavitySphere {
+        /// Cavity centre, a's frame [m].
+        cavity_centre: Vec3,
+        /// Cavity radius [m].
+        cavity_radius: f64,
+        /// Sphere centre, b's frame [m].
+        sphere_centre: Vec3,
+        /// Sphere radius [m].
+        sphere_radius: f64,
+    },
 }
 
 impl PairGeometry {
@@ -114,14 +149,10 @@ impl PairGeometry {
     pub const SUPPORTED: &'static str =
         "ball–half-space, ball–ball, ball–cuboid, cuboid–half-space, cylinder–tube, ball–tube";
 
-    /// The method for a pair of shapes in either order, or `None` if unsupported.
-    /// The returned flag is true when the canonical order is (b, a).
-    pub fn select(a: &ShapeSpec, b: &ShapeSpec) -> Option<(Self, bool)> {
-        Self::select_with_points(a, b, 5)
-    }
-
-    /// As [`select`](Self::select), with the cylinder–tube sample count.
-    pub fn select_with_points(a: &ShapeSpec, b: &ShapeSpec, points: u32) -> Option<(Self, bool)> {
+    /// The method for a pair of shapes in either order (with the
+    /// cylinder–tube sample count), or `None` if unsupported. The returned
+    /// flag is true when the canonical order is (b, a).
+    pub fn select(a: &ShapeSpec, b: &ShapeSpec, points: u32) -> Option<(Self, bool)> {
         use ShapeSpec as S;
         let canonical = |x: &ShapeSpec, y: &ShapeSpec| -> Option<Self> {
             match (x, y) {
@@ -144,7 +175,11 @@ impl PairGeometry {
     /// Number of point slots a pair of this kind can report.
     pub fn slots(self) -> usize {
         match self {
-            Self::ParryConvex | Self::BallTube => 1,
+            Self::ParryConvex
+            | Self::BallTube
+            | Self::TorusBall { .. }
+            | Self::SlotBall { .. }
+            | Self::CavitySphere { .. } => 1,
             Self::CuboidHalfSpace => 8,
             Self::CylinderTube { points } => points as usize,
         }
@@ -174,6 +209,50 @@ impl PairGeometry {
                 },
             ) => cylinder_tube(t, p1, *radius, *half_length, points, p2, out),
             (Self::BallTube, Shape::Tube(t), Shape::Ball(b)) => ball_tube(t, p1, b.radius, p2, out),
+            (
+                Self::TorusBall {
+                    centre,
+                    axis,
+                    core_radius,
+                    tube_radius,
+                    ball_radius,
+                },
+                _,
+                _,
+            ) => torus_ball(
+                &centre,
+                &axis,
+                core_radius,
+                tube_radius,
+                ball_radius,
+                p1,
+                p2,
+                out,
+            ),
+            (
+                Self::SlotBall {
+                    centre,
+                    normal,
+                    half_width,
+                    ball_radius,
+                },
+                _,
+                _,
+            ) => slot_ball(&centre, &normal, half_width, ball_radius, p1, p2, out),
+            (
+                Self::CavitySphere {
+                    cavity_centre,
+                    cavity_radius,
+                    sphere_centre,
+                    sphere_radius,
+                },
+                _,
+                _,
+            ) => {
+                let oa = p1.0 + p1.1 * cavity_centre;
+                let ob = p2.0 + p2.1 * sphere_centre;
+                cavity_sphere(&oa, cavity_radius, &ob, sphere_radius, out)
+            }
             _ => {}
         }
     }
@@ -316,6 +395,94 @@ fn ball_tube(
     }
 }
 
+/// Ball (centre p, world) in the tube of a torus on body a.
+#[allow(clippy::too_many_arguments)]
+fn torus_ball(
+    centre: &Vec3,
+    axis: &Vec3,
+    core_radius: f64,
+    tube_radius: f64,
+    ball_radius: f64,
+    pa: (&Vec3, &Quat),
+    pb: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let p = pa.1.inverse() * (pb.0 - pa.0);
+    let r = p - centre;
+    let in_plane = r - r.dot(axis) * axis;
+    let len = in_plane.norm();
+    if len < 1e-15 {
+        return;
+    }
+    let q = centre + core_radius * in_plane / len;
+    let to_core = q - p;
+    let d = to_core.norm();
+    let depth = d + ball_radius - tube_radius;
+    if depth <= 0.0 || d < 1e-15 {
+        return;
+    }
+    // The wall pushes the ball back toward the core circle.
+    let n = to_core / d;
+    let ball_surface = p - ball_radius * n;
+    let point = ball_surface + 0.5 * depth * n;
+    out.push(ContactPoint {
+        slot: 0,
+        point: pa.0 + pa.1 * point,
+        normal: pa.1 * n,
+        depth,
+    });
+}
+
+/// Ball (centre p, world) between two parallel planes of body a.
+fn slot_ball(
+    centre: &Vec3,
+    normal: &Vec3,
+    half_width: f64,
+    ball_radius: f64,
+    pa: (&Vec3, &Quat),
+    pb: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let p = pa.1.inverse() * (pb.0 - pa.0);
+    let u = (p - centre).dot(normal);
+    let depth = ball_radius + u.abs() - half_width;
+    if depth <= 0.0 {
+        return;
+    }
+    let side = if u >= 0.0 { 1.0 } else { -1.0 };
+    let point = p + side * (ball_radius - 0.5 * depth) * normal;
+    out.push(ContactPoint {
+        slot: 0,
+        point: pa.0 + pa.1 * point,
+        normal: pa.1 * (-side * normal),
+        depth,
+    });
+}
+
+/// Sphere (centre ob, world) inside a cavity (centre oa, world).
+fn cavity_sphere(
+    oa: &Vec3,
+    cavity_radius: f64,
+    ob: &Vec3,
+    sphere_radius: f64,
+    out: &mut Vec<ContactPoint>,
+) {
+    let r = ob - oa;
+    let d = r.norm();
+    let depth = d + sphere_radius - cavity_radius;
+    if depth <= 0.0 || d < 1e-15 {
+        return;
+    }
+    let u = r / d;
+    let point = ob + (sphere_radius - 0.5 * depth) * u;
+    out.push(ContactPoint {
+        slot: 0,
+        point,
+        normal: -u,
+        depth,
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -333,11 +500,11 @@ mod tests {
         let ball = ShapeSpec::Ball { radius: 0.1 };
         // Declared either way round, the pair resolves to half-space first.
         assert_eq!(
-            PairGeometry::select(&ball, &ground),
+            PairGeometry::select(&ball, &ground, 5),
             Some((PairGeometry::ParryConvex, true))
         );
         assert_eq!(
-            PairGeometry::select(&ground, &ball),
+            PairGeometry::select(&ground, &ball, 5),
             Some((PairGeometry::ParryConvex, false))
         );
         let (ground, ball) = (Shape::from_spec(&ground), Shape::from_spec(&ball));
@@ -409,6 +576,87 @@ mod tests {
             assert_relative_eq!(p.depth, 1e-3, epsilon = 1e-12);
             assert_relative_eq!(p.normal, Vec3::new(0.0, 0.0, -1.0), epsilon = 1e-12);
         }
+    }
+
+    #[test]
+    fn ball_in_a_torus_groove_touches_the_flank_at_the_section_circle() {
+        // Core circle radius 0.03 about z in the xy plane; section radius 0.0078; ball 0.0075.
+        let g = PairGeometry::TorusBall {
+            centre: Vec3::zeros(),
+            axis: Vec3::z(),
+            core_radius: 0.03,
+            tube_radius: 0.0078,
+            ball_radius: 0.0075,
+        };
+        let a = pose([0.1, 0.2, 0.3]);
+        let none = Shape::Cylinder {
+            radius: 1.0,
+            half_length: 1.0,
+        };
+        // Ball centre 0.0004 from the core circle, outward at 30°: overlap 0.0004 + 0.0075 − 0.0078 = 0.0001.
+        let th = 30f64.to_radians();
+        let radial = Vec3::new(th.cos(), th.sin(), 0.0);
+        let b = (a.0 + radial * 0.0304, Quat::identity());
+        let mut out = vec![];
+        g.contacts(&none, (&a.0, &a.1), &none, (&b.0, &b.1), &mut out);
+        assert_eq!(out.len(), 1);
+        assert_relative_eq!(out[0].depth, 1e-4, epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, -radial, epsilon = 1e-12);
+        // Inside the clearance there is no contact.
+        let b = (a.0 + radial * 0.0302, Quat::identity());
+        out.clear();
+        g.contacts(&none, (&a.0, &a.1), &none, (&b.0, &b.1), &mut out);
+        assert!(out.is_empty());
+    }
+
+    #[test]
+    fn ball_in_a_slot_is_pushed_back_from_the_face_it_crosses() {
+        let g = PairGeometry::SlotBall {
+            centre: Vec3::zeros(),
+            normal: Vec3::y(),
+            half_width: 0.008,
+            ball_radius: 0.0075,
+        };
+        let none = Shape::Cylinder {
+            radius: 1.0,
+            half_length: 1.0,
+        };
+        // Body a rotated 90° about z: its y axis is world −x.
+        let qa = Quat::from_axis_angle(&Vec3::z_axis(), std::f64::consts::FRAC_PI_2);
+        let pa = Vec3::zeros();
+        let pb = Vec3::new(-0.0007, 0.0, 0.0);
+        let mut out = vec![];
+        g.contacts(&none, (&pa, &qa), &none, (&pb, &Quat::identity()), &mut out);
+        assert_eq!(out.len(), 1);
+        assert_relative_eq!(out[0].depth, 2e-4, epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, Vec3::x(), epsilon = 1e-12);
+    }
+
+    #[test]
+    fn eccentric_sphere_in_a_cavity_is_pushed_toward_the_cavity_centre() {
+        let g = PairGeometry::CavitySphere {
+            cavity_centre: Vec3::new(0.0, 0.0, 0.1),
+            cavity_radius: 0.032,
+            sphere_centre: Vec3::zeros(),
+            sphere_radius: 0.031,
+        };
+        let none = Shape::Cylinder {
+            radius: 1.0,
+            half_length: 1.0,
+        };
+        let pa = Vec3::zeros();
+        let pb = Vec3::new(0.0, 0.0011, 0.1);
+        let mut out = vec![];
+        g.contacts(
+            &none,
+            (&pa, &Quat::identity()),
+            &none,
+            (&pb, &Quat::identity()),
+            &mut out,
+        );
+        assert_eq!(out.len(), 1);
+        assert_relative_eq!(out[0].depth, 1e-4, epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, -Vec3::y(), epsilon = 1e-12);
     }
 
     #[test]

@@ -2,12 +2,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Scene, non_negative, positive};
+use super::{Scene, ShapeSpec, direction, finite_vec, non_negative, positive};
 use crate::error::SceneError;
 use crate::force::{
     AdamsFrictionParams, DissipativeLaw, DissipativeParams, FrictionLaw, HertzParams, ImpactParams,
     LinearParams, NormalLaw, TanhFrictionParams,
 };
+use crate::geometry::PairGeometry;
+use crate::math::Vec3;
 
 /// Units in which a law's parameters are written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -322,6 +324,49 @@ impl FrictionLawSpec {
     }
 }
 
+/// Explicit contact geometry fixed to the pair's bodies, for surfaces that
+/// are not a body's main shape (races, windows, spherical seats). All vectors
+/// are in the named body's frame [m].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum FeatureSpec {
+    /// Ball b inside the tube of a torus on body a: a groove flank of
+    /// circular section `tube_radius` swept around a core circle.
+    /// δ = |p − q| + r_ball − tube_radius, q the core-circle point nearest the ball centre p.
+    TorusBall {
+        /// Core-circle centre, body a frame.
+        centre: [f64; 3],
+        /// Normal of the core circle's plane, body a frame.
+        axis: [f64; 3],
+        /// Core-circle radius [m].
+        core_radius: f64,
+        /// Section (tube) radius [m], larger than the ball's.
+        tube_radius: f64,
+    },
+    /// Ball b between two parallel planes of body a (a window):
+    /// δ = r_ball − (half_width − |(p − centre)·normal|).
+    SlotBall {
+        /// Mid-plane point, body a frame.
+        centre: [f64; 3],
+        /// Plane normal, body a frame.
+        normal: [f64; 3],
+        /// Half of the gap between the planes [m].
+        half_width: f64,
+    },
+    /// A sphere fixed to body b inside a spherical cavity of body a:
+    /// δ = |o_b − o_a| + sphere_radius − cavity_radius.
+    CavitySphere {
+        /// Cavity centre, body a frame.
+        cavity_centre: [f64; 3],
+        /// Cavity radius [m].
+        cavity_radius: f64,
+        /// Sphere centre, body b frame.
+        sphere_centre: [f64; 3],
+        /// Sphere radius [m], smaller than the cavity's.
+        sphere_radius: f64,
+    },
+}
+
 /// A pair of bodies that may touch, and the laws of their contact.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -337,6 +382,9 @@ pub struct ContactSpec {
     /// Friction law; none means frictionless (no friction term is built).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub friction: Option<FrictionLawSpec>,
+    /// Explicit geometry; without it the bodies' shapes decide.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<FeatureSpec>,
     /// Sample points along a cylinder's axis for cylinder–tube contact (≥ 2:
     /// both end rims and evenly spaced interior points).
     #[serde(default = "default_points")]
@@ -355,37 +403,131 @@ impl ContactSpec {
             .unwrap_or_else(|| format!("{}/{}", self.bodies[0], self.bodies[1]))
     }
 
-    pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
-        let mut shapes = Vec::with_capacity(2);
+    /// The point finder of this pair, and whether the canonical order is (b, a).
+    pub fn resolve_geometry(
+        &self,
+        path: &str,
+        scene: &Scene,
+    ) -> Result<(PairGeometry, bool), SceneError> {
+        let mut idx = [0usize; 2];
         for (k, name) in self.bodies.iter().enumerate() {
-            let Some(i) = scene.body_index(name) else {
-                return Err(SceneError::new(
-                    format!("{path}.bodies[{k}]"),
-                    name,
-                    "no body of that name",
-                ));
-            };
-            shapes.push(&scene.bodies[i].shape);
+            idx[k] = scene.body_index(name).ok_or_else(|| {
+                SceneError::new(format!("{path}.bodies[{k}]"), name, "no body of that name")
+            })?;
         }
-        if self.bodies[0] == self.bodies[1] {
+        if idx[0] == idx[1] {
             return Err(SceneError::new(
                 format!("{path}.bodies"),
                 format!("{:?}", self.bodies),
                 "a body cannot touch itself",
             ));
         }
-        if crate::geometry::PairGeometry::select(shapes[0], shapes[1]).is_none() {
-            return Err(SceneError::new(
-                format!("{path}.bodies"),
-                format!("{:?}", self.bodies),
+        let (sa, sb) = (&scene.bodies[idx[0]].shape, &scene.bodies[idx[1]].shape);
+        let Some(feature) = &self.geometry else {
+            return PairGeometry::select(sa, sb, self.points).ok_or_else(|| {
+                SceneError::new(
+                    format!("{path}.bodies"),
+                    format!("{:?}", self.bodies),
+                    format!(
+                        "no contact geometry for a {}–{} pair (supported: {}; or give `geometry`)",
+                        sa.kind_name(),
+                        sb.kind_name(),
+                        PairGeometry::SUPPORTED
+                    ),
+                )
+            });
+        };
+        let g = format!("{path}.geometry");
+        let ball_radius = || match sb {
+            ShapeSpec::Ball { radius } => Ok(*radius),
+            other => Err(SceneError::new(
+                format!("{path}.bodies[1]"),
+                &self.bodies[1],
                 format!(
-                    "no contact geometry for a {}–{} pair (supported: {})",
-                    shapes[0].kind_name(),
-                    shapes[1].kind_name(),
-                    crate::geometry::PairGeometry::SUPPORTED
+                    "this geometry needs body b to be a ball, not a {}",
+                    other.kind_name()
                 ),
-            ));
-        }
+            )),
+        };
+        let geometry = match feature {
+            FeatureSpec::TorusBall {
+                centre,
+                axis,
+                core_radius,
+                tube_radius,
+            } => {
+                finite_vec(&format!("{g}.centre"), centre)?;
+                direction(&format!("{g}.axis"), axis)?;
+                positive(&format!("{g}.core_radius"), *core_radius)?;
+                positive(&format!("{g}.tube_radius"), *tube_radius)?;
+                let r = ball_radius()?;
+                if r >= *tube_radius {
+                    return Err(SceneError::new(
+                        format!("{g}.tube_radius"),
+                        tube_radius,
+                        format!("must exceed the ball radius {r}"),
+                    ));
+                }
+                PairGeometry::TorusBall {
+                    centre: Vec3::from(*centre),
+                    axis: Vec3::from(*axis).normalize(),
+                    core_radius: *core_radius,
+                    tube_radius: *tube_radius,
+                    ball_radius: r,
+                }
+            }
+            FeatureSpec::SlotBall {
+                centre,
+                normal,
+                half_width,
+            } => {
+                finite_vec(&format!("{g}.centre"), centre)?;
+                direction(&format!("{g}.normal"), normal)?;
+                positive(&format!("{g}.half_width"), *half_width)?;
+                let r = ball_radius()?;
+                if r >= *half_width {
+                    return Err(SceneError::new(
+                        format!("{g}.half_width"),
+                        half_width,
+                        format!("must exceed the ball radius {r}"),
+                    ));
+                }
+                PairGeometry::SlotBall {
+                    centre: Vec3::from(*centre),
+                    normal: Vec3::from(*normal).normalize(),
+                    half_width: *half_width,
+                    ball_radius: r,
+                }
+            }
+            FeatureSpec::CavitySphere {
+                cavity_centre,
+                cavity_radius,
+                sphere_centre,
+                sphere_radius,
+            } => {
+                finite_vec(&format!("{g}.cavity_centre"), cavity_centre)?;
+                finite_vec(&format!("{g}.sphere_centre"), sphere_centre)?;
+                positive(&format!("{g}.cavity_radius"), *cavity_radius)?;
+                positive(&format!("{g}.sphere_radius"), *sphere_radius)?;
+                if sphere_radius >= cavity_radius {
+                    return Err(SceneError::new(
+                        format!("{g}.sphere_radius"),
+                        sphere_radius,
+                        format!("must be smaller than cavity_radius = {cavity_radius}"),
+                    ));
+                }
+                PairGeometry::CavitySphere {
+                    cavity_centre: Vec3::from(*cavity_centre),
+                    cavity_radius: *cavity_radius,
+                    sphere_centre: Vec3::from(*sphere_centre),
+                    sphere_radius: *sphere_radius,
+                }
+            }
+        };
+        Ok((geometry, false))
+    }
+
+    pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
         if !(2..=64).contains(&self.points) {
             return Err(SceneError::new(
                 format!("{path}.points"),
@@ -393,6 +535,7 @@ impl ContactSpec {
                 "must lie in 2..=64 (2 = both end rims)",
             ));
         }
+        self.resolve_geometry(path, scene)?;
         self.normal.to_law(&format!("{path}.normal"))?;
         if let Some(f) = &self.friction {
             f.to_law(&format!("{path}.friction"))?;

@@ -13,7 +13,7 @@ mod load;
 mod overrides;
 
 pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
-pub use contact::{ContactSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
+pub use contact::{ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
 pub use load::LoadSpec;
 pub use overrides::apply_override;
 
@@ -151,6 +151,10 @@ pub struct Scene {
     /// Applied loads.
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
+    /// The higher-level spec this scene was expanded from, if any; it is what
+    /// [`Scene::to_toml`] writes back.
+    #[serde(skip)]
+    pub origin: Option<Box<crate::drillpipe::DrillPipeSpec>>,
 }
 
 impl Scene {
@@ -164,30 +168,50 @@ impl Scene {
 
     /// Builds a scene from a TOML table (any serde source converts to one),
     /// applies overrides, deserializes with field paths, and validates.
+    ///
+    /// A table with `kind = "drill-pipe"` (or, without `kind` and without
+    /// `bodies`, with a `pipe`, `borehole` or `drive` section) is a
+    /// [`DrillPipeSpec`](crate::drillpipe::DrillPipeSpec), expanded here.
     pub fn from_table(table: toml::Table, overrides: &[String]) -> Result<Self, SceneError> {
-        let mut root = toml::Value::Table(table);
+        let drill_pipe = match table.get("kind") {
+            Some(toml::Value::String(k)) if k == crate::drillpipe::KIND => true,
+            Some(toml::Value::String(k)) if k == "generic" => false,
+            Some(other) => {
+                return Err(SceneError::new(
+                    "kind",
+                    other,
+                    format!(
+                        "unknown scene kind (kinds: \"generic\", \"{}\")",
+                        crate::drillpipe::KIND
+                    ),
+                ));
+            }
+            None => {
+                !table.contains_key("bodies")
+                    && ["pipe", "borehole", "drive"]
+                        .iter()
+                        .any(|k| table.contains_key(*k))
+            }
+        };
+        let mut root = if drill_pipe {
+            // Sections and fields left out take the paper's values.
+            let mut base = toml::Value::try_from(crate::drillpipe::DrillPipeSpec::default())
+                .map_err(|e| SceneError::new("", "", format!("default drill-pipe scene: {e}")))?;
+            merge(&mut base, toml::Value::Table(table));
+            base
+        } else {
+            let mut t = table;
+            t.remove("kind");
+            toml::Value::Table(t)
+        };
         for o in overrides {
             apply_override(&mut root, o)?;
         }
-        let scene: Scene = serde_path_to_error::deserialize(root).map_err(|e| {
-            let mut path = e.path().to_string();
-            if path == "." {
-                path.clear();
-            }
-            let reason = first_line(&e.into_inner().to_string());
-            // serde reports a missing field at its parent: name the field itself.
-            if let Some(field) = reason
-                .strip_prefix("missing field `")
-                .and_then(|r| r.split('`').next())
-            {
-                path = if path.is_empty() {
-                    field.to_string()
-                } else {
-                    format!("{path}.{field}")
-                };
-            }
-            SceneError::new(path, "", reason)
-        })?;
+        if drill_pipe {
+            let spec: crate::drillpipe::DrillPipeSpec = deserialize_with_path(root)?;
+            return spec.expand();
+        }
+        let scene: Scene = deserialize_with_path(root)?;
         scene.validate()?;
         Ok(scene)
     }
@@ -293,6 +317,57 @@ impl Scene {
         let n = (self.simulation.duration / self.simulation.dt).round() as u64;
         n.max(1)
     }
+}
+
+/// Writes `over` onto `base`: tables merge key by key, anything else
+/// replaces. A table whose tag (`law` or `type`) differs replaces whole, so a
+/// different law does not inherit the old law's parameters.
+fn merge(base: &mut toml::Value, over: toml::Value) {
+    match (base, over) {
+        (toml::Value::Table(b), toml::Value::Table(o)) => {
+            let retagged = ["law", "type"]
+                .iter()
+                .any(|tag| matches!((b.get(*tag), o.get(*tag)), (Some(x), Some(y)) if x != y));
+            if retagged {
+                *b = o;
+                return;
+            }
+            for (k, v) in o {
+                match b.get_mut(&k) {
+                    Some(slot) => merge(slot, v),
+                    None => {
+                        b.insert(k, v);
+                    }
+                }
+            }
+        }
+        (b, o) => *b = o,
+    }
+}
+
+/// Deserializes with the path of the offending field in the error.
+fn deserialize_with_path<T: serde::de::DeserializeOwned>(
+    root: toml::Value,
+) -> Result<T, SceneError> {
+    serde_path_to_error::deserialize(root).map_err(|e| {
+        let mut path = e.path().to_string();
+        if path == "." {
+            path.clear();
+        }
+        let reason = first_line(&e.into_inner().to_string());
+        // serde reports a missing field at its parent: name the field itself.
+        if let Some(field) = reason
+            .strip_prefix("missing field `")
+            .and_then(|r| r.split('`').next())
+        {
+            path = if path.is_empty() {
+                field.to_string()
+            } else {
+                format!("{path}.{field}")
+            };
+        }
+        SceneError::new(path, "", reason)
+    })
 }
 
 fn first_line(s: &str) -> String {

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs what the tests need and runs every test: Rust checks and tests,
+# then the release wheel and pytest. Used by the README and by .ci/run.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== cargo fmt"
+cargo fmt --all -- --check
+echo "== cargo clippy"
+cargo clippy --workspace --all-targets -- -D warnings
+echo "== cargo test"
+cargo test --workspace
+echo "== pip install .[test] (release build of the wheel)"
+python3 -m pip install --quiet --upgrade pip
+python3 -m pip install --quiet ".[test]"
+echo "== pytest"
+# The package source lives in python/, so the root is not on the import path
+# as `ballcage`: pytest imports the installed wheel.
+status=0
+python3 -m pytest -q || status=$?
+if [ "$status" -eq 5 ]; then
+  echo "pytest collected no tests"; exit 1
+fi
+exit "$status"
