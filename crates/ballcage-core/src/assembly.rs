@@ -13,13 +13,12 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
     for (i, b) in scene.bodies.iter().enumerate() {
         let q0 = b.orientation;
         let rot = Quat::from_quaternion(nalgebra::Quaternion::new(q0[0], q0[1], q0[2], q0[3]));
-        let (mass, inertia) = if b.is_integrated() {
-            let (m, i3) = b
-                .mass_properties()
-                .ok_or_else(|| SceneError::new(format!("bodies[{i}].mass"), "", "missing"))?;
-            (m, Vec3::from(i3))
-        } else {
-            (0.0, Vec3::zeros())
+        let (mass, inertia) = match b.mass_properties() {
+            Some((m, i3)) => (m, Vec3::from(i3)),
+            None if b.is_integrated() => {
+                return Err(SceneError::new(format!("bodies[{i}].mass"), "", "missing"));
+            }
+            None => (0.0, Vec3::zeros()),
         };
         let axis = b
             .spin_axis
@@ -118,6 +117,10 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
                 .filter_map(|n| scene.body_index(n))
                 .collect()
         },
+        summary_window: match scene.record.summary_window.as_slice() {
+            [a, b] => (*a, *b),
+            _ => (0.0, f64::INFINITY),
+        },
         pairs: if scene.record.contacts.is_empty() {
             (0..pairs.len()).collect()
         } else {
@@ -153,7 +156,7 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
     let integrated = (0..bodies.len())
         .filter(|&i| bodies[i].is_integrated())
         .collect();
-    let model = Model {
+    let mut model = Model {
         bodies,
         integrated,
         pairs,
@@ -165,6 +168,7 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
         total_steps: scene.total_steps(),
         record,
         name: scene.name.clone(),
+        drill_pipe: None,
     };
     let mut state = state;
     // A spin body's velocity is only its spin about the axis.
@@ -174,6 +178,10 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
             state.omega[i] = axis_body * state.omega[i].dot(&axis_body);
         }
     }
+    model.drill_pipe = scene
+        .origin
+        .as_ref()
+        .map(|spec| crate::drillpipe::Layout::new(spec, &model.bodies, &model.pairs));
     model.prescribe(0.0, &mut state);
     Ok((model, state))
 }

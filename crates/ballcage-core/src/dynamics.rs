@@ -56,6 +56,24 @@ pub struct ContactEval {
     pub slip_speed: f64,
 }
 
+/// Energy of the system at one instant [J].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Energy {
+    /// Kinetic energy of the integrated bodies.
+    pub kinetic: f64,
+    /// Gravitational potential energy of the integrated bodies, zero at the world origin.
+    pub potential_gravity: f64,
+    /// Elastic energy stored in the contacts.
+    pub potential_contact: f64,
+}
+
+impl Energy {
+    /// Sum of all parts.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.potential_gravity + self.potential_contact
+    }
+}
+
 /// Force evaluator with its scratch space and per-contact memory.
 #[derive(Debug, Clone)]
 pub struct Dynamics {
@@ -182,19 +200,32 @@ impl Dynamics {
         self.points = points;
     }
 
-    /// Elastic energy stored in all contacts at `state` [J].
-    pub fn contact_energy(&mut self, model: &Model, state: &State) -> f64 {
-        let mut e = 0.0;
+    /// Kinetic, gravitational and elastic contact energy at `state`.
+    pub fn energy(&mut self, model: &Model, state: &State) -> Energy {
+        let mut kinetic = 0.0;
+        let mut potential_gravity = 0.0;
+        for &i in &model.integrated {
+            let b = &model.bodies[i];
+            let w = state.omega[i];
+            kinetic += 0.5 * b.mass * state.vel[i].norm_squared()
+                + 0.5 * w.dot(&b.inertia.component_mul(&w));
+            potential_gravity -= b.mass * model.gravity.dot(&state.pos[i]);
+        }
+        let mut potential_contact = 0.0;
         let mut points = std::mem::take(&mut self.points);
         for pair in &model.pairs {
             find_points(model, pair, state, &mut points);
-            e += points
+            potential_contact += points
                 .iter()
                 .map(|p| pair.normal.elastic_energy(p.depth))
                 .sum::<f64>();
         }
         self.points = points;
-        e
+        Energy {
+            kinetic,
+            potential_gravity,
+            potential_contact,
+        }
     }
 }
 

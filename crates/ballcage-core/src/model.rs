@@ -50,6 +50,15 @@ impl SpinProfile {
         }
     }
 
+    /// Spin acceleration dω/dt [rad/s²].
+    pub fn acceleration_at(&self, t: f64) -> f64 {
+        if self.ramp <= 0.0 {
+            0.0
+        } else {
+            step(t, 0.0, 0.0, self.ramp, self.speed).1
+        }
+    }
+
     /// Spin speed ω(t) = STEP(t, 0, 0, t_r, ω₀) [rad/s].
     pub fn speed_at(&self, t: f64) -> f64 {
         if self.ramp <= 0.0 {
@@ -67,7 +76,7 @@ pub struct Body {
     pub name: String,
     /// How it moves.
     pub motion: Motion,
-    /// Mass [kg]; 0 for fixed and kinematic bodies.
+    /// Mass [kg]; 0 for bodies without mass properties (half-spaces, tubes).
     pub mass: f64,
     /// Principal inertia about body x, y, z [kg·m²].
     pub inertia: Vec3,
@@ -137,6 +146,8 @@ pub struct RecordPlan {
     pub bodies: Vec<usize>,
     /// Pair indices recorded in `contacts`.
     pub pairs: Vec<usize>,
+    /// Window `[start, end]` of the `summary` table [s].
+    pub summary_window: (f64, f64),
 }
 
 /// Read-only after assembly.
@@ -164,6 +175,8 @@ pub struct Model {
     pub record: RecordPlan,
     /// Scene name.
     pub name: String,
+    /// Where the drill pipe's parts are, for drill-pipe scenes.
+    pub drill_pipe: Option<crate::drillpipe::Layout>,
 }
 
 impl Model {

@@ -201,19 +201,22 @@ impl Simulation {
     }
 }
 
+/// The embedded default scene (the paper's drill pipe) as TOML.
+#[pyfunction]
+fn default_scene_toml() -> String {
+    ballcage_core::drillpipe::DrillPipeSpec::default().to_toml()
+}
+
 /// The Arrow schema of an output table (`bodies`, `contacts`, `energy`).
 #[pyfunction]
 fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-    let kind = match name {
-        "bodies" => TableKind::Bodies,
-        "contacts" => TableKind::Contacts,
-        "energy" => TableKind::Energy,
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "table `{name}`: unknown (tables are bodies, contacts, energy)"
-            )));
-        }
-    };
+    let kind = TableKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = TableKind::ALL.iter().map(|k| k.name()).collect();
+        PyValueError::new_err(format!(
+            "table `{name}`: unknown (tables are {})",
+            names.join(", ")
+        ))
+    })?;
     let schema = ballcage_core::output::schema(kind, HashMap::new());
     PySchema::new(Arc::new(schema)).into_pyarrow(py)
 }
@@ -235,5 +238,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scene>()?;
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(table_schema, m)?)?;
+    m.add_function(wrap_pyfunction!(default_scene_toml, m)?)?;
+    m.add(
+        "TABLE_NAMES",
+        TableKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>(),
+    )?;
     Ok(())
 }

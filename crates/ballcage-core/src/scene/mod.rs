@@ -86,6 +86,16 @@ pub enum TableKind {
     Contacts,
     /// Energy balance per frame.
     Energy,
+    /// Per-pair peak, mean and RMS of normal and tangential force over `record.summary_window`.
+    Summary,
+    /// Drill pipe: per link per frame, the paper's eq. (4) angles and position.
+    Links,
+    /// Drill pipe: per hinge per frame, bend angle and cage forces.
+    Hinges,
+    /// Drill pipe: per ball key per frame, race and window forces.
+    Keys,
+    /// Drill pipe: per frame, input/output torque, speed, power and efficiency.
+    Drive,
 }
 
 impl TableKind {
@@ -95,7 +105,34 @@ impl TableKind {
             Self::Bodies => "bodies",
             Self::Contacts => "contacts",
             Self::Energy => "energy",
+            Self::Summary => "summary",
+            Self::Links => "links",
+            Self::Hinges => "hinges",
+            Self::Keys => "keys",
+            Self::Drive => "drive",
         }
+    }
+
+    /// Every table kind.
+    pub const ALL: [TableKind; 8] = [
+        Self::Bodies,
+        Self::Contacts,
+        Self::Energy,
+        Self::Summary,
+        Self::Links,
+        Self::Hinges,
+        Self::Keys,
+        Self::Drive,
+    ];
+
+    /// The kind named `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Whether only drill-pipe scenes can record it.
+    pub fn needs_drill_pipe(self) -> bool {
+        matches!(self, Self::Links | Self::Hinges | Self::Keys | Self::Drive)
     }
 }
 
@@ -112,6 +149,9 @@ pub struct RecordSpec {
     /// Contact pairs recorded in `contacts`; empty means every pair.
     #[serde(default)]
     pub contacts: Vec<String>,
+    /// Time window `[start, end]` of the `summary` table [s]; empty means the whole run.
+    #[serde(default)]
+    pub summary_window: Vec<f64>,
 }
 
 fn default_tables() -> Vec<TableKind> {
@@ -124,6 +164,7 @@ impl Default for RecordSpec {
             tables: default_tables(),
             bodies: vec![],
             contacts: vec![],
+            summary_window: vec![],
         }
     }
 }
@@ -285,6 +326,41 @@ impl Scene {
         }
         for (i, l) in self.loads.iter().enumerate() {
             l.validate(&format!("loads[{i}]"), self)?;
+        }
+        for (i, t) in self.record.tables.iter().enumerate() {
+            if t.needs_drill_pipe() && self.origin.is_none() {
+                return Err(SceneError::new(
+                    format!("record.tables[{i}]"),
+                    t.name(),
+                    "only drill-pipe scenes (kind = \"drill-pipe\") have this table",
+                ));
+            }
+            if self.record.tables[..i].contains(t) {
+                return Err(SceneError::new(
+                    format!("record.tables[{i}]"),
+                    t.name(),
+                    "listed twice",
+                ));
+            }
+        }
+        let w = &self.record.summary_window;
+        if !w.is_empty() {
+            if w.len() != 2 {
+                return Err(SceneError::new(
+                    "record.summary_window",
+                    format!("{w:?}"),
+                    "give [start, end] in seconds",
+                ));
+            }
+            non_negative("record.summary_window[0]", w[0])?;
+            finite("record.summary_window[1]", w[1])?;
+            if w[1] <= w[0] {
+                return Err(SceneError::new(
+                    "record.summary_window[1]",
+                    w[1],
+                    format!("must exceed the start {} s", w[0]),
+                ));
+            }
         }
         for (i, n) in self.record.bodies.iter().enumerate() {
             if self.body_index(n).is_none() {

@@ -1,6 +1,10 @@
 //! What gets kept: the column definitions of every output table (the one
 //! schema of the project) and columnar buffers filled once per frame.
 
+mod frame;
+
+pub use frame::Recorder;
+
 use crate::scene::TableKind;
 
 /// Physical type of a column.
@@ -222,12 +226,227 @@ pub const ENERGY: &[ColumnDef] = &[
     ),
 ];
 
+/// Columns of the `summary` table: one row per contact pair.
+pub const SUMMARY: &[ColumnDef] = &[
+    col(
+        "pair_id",
+        U32,
+        "",
+        "contact pair index in the scene's contact list",
+    ),
+    col("pair", Name(Dictionary::Pairs), "", "contact pair name"),
+    col("window_start", F64, "s", "start of the summary window"),
+    col("window_end", F64, "s", "end of the summary window"),
+    col("frames", U64, "", "recorded frames in the window"),
+    col(
+        "normal_peak",
+        F64,
+        "N",
+        "largest per-frame total normal force of the pair",
+    ),
+    col(
+        "normal_mean",
+        F64,
+        "N",
+        "mean per-frame total normal force (frames without contact count as 0)",
+    ),
+    col(
+        "normal_rms",
+        F64,
+        "N",
+        "root mean square of the per-frame total normal force",
+    ),
+    col(
+        "tangential_peak",
+        F64,
+        "N",
+        "largest per-frame magnitude of the summed friction force",
+    ),
+    col(
+        "tangential_mean",
+        F64,
+        "N",
+        "mean per-frame magnitude of the summed friction force",
+    ),
+    col(
+        "tangential_rms",
+        F64,
+        "N",
+        "root mean square of the per-frame friction force magnitude",
+    ),
+];
+
+/// Columns of the `links` table (drill pipe): one row per link per frame.
+pub const LINKS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "link",
+        U32,
+        "",
+        "link number, 1 at the top (the paper's joint number)",
+    ),
+    col("body", Name(Dictionary::Bodies), "", "body name"),
+    col(
+        "inclination_deg",
+        F64,
+        "deg",
+        "eq. (4) φ: angle of the link axis from the downward vertical",
+    ),
+    col(
+        "azimuth_deg",
+        F64,
+        "deg",
+        "eq. (4) θ: azimuth of the link axis about the vertical, from the bend direction (+x)",
+    ),
+    col("com_x", F64, "m", "centre of mass x, world frame"),
+    col("com_y", F64, "m", "centre of mass y, world frame"),
+    col("com_z", F64, "m", "centre of mass z, world frame"),
+    col(
+        "radial_offset",
+        F64,
+        "m",
+        "distance of the centre of mass from the tube centreline (extended straight past the arc)",
+    ),
+    col(
+        "included_angle_deg",
+        F64,
+        "deg",
+        "angle between this link's axis and the next body's, 180 when straight",
+    ),
+];
+
+/// Columns of the `hinges` table (drill pipe): one row per hinge per frame.
+pub const HINGES: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "hinge",
+        U32,
+        "",
+        "hinge number, 0 between the upper connector and link 1",
+    ),
+    col("bend_deg", F64, "deg", "angle between the two bodies' axes"),
+    col(
+        "cage_head_normal",
+        F64,
+        "N",
+        "normal force between cage and ball head",
+    ),
+    col(
+        "cage_head_tangential",
+        F64,
+        "N",
+        "friction force magnitude between cage and ball head",
+    ),
+    col(
+        "cage_seat_normal",
+        F64,
+        "N",
+        "normal force between cage and ball seat",
+    ),
+    col(
+        "cage_seat_tangential",
+        F64,
+        "N",
+        "friction force magnitude between cage and ball seat",
+    ),
+];
+
+/// Columns of the `keys` table (drill pipe): one row per ball key per frame.
+/// Race forces add both Gothic-arch flanks; window forces both window pairs.
+pub const KEYS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col("hinge", U32, "", "hinge number"),
+    col("key", U32, "", "ball key number, 0–5 around the joint"),
+    col(
+        "inner_normal",
+        F64,
+        "N",
+        "normal force on the inner race (ball head grooves), both flanks",
+    ),
+    col(
+        "inner_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the inner race",
+    ),
+    col(
+        "outer_normal",
+        F64,
+        "N",
+        "normal force on the outer race (ball seat grooves), both flanks",
+    ),
+    col(
+        "outer_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the outer race",
+    ),
+    col(
+        "window_normal",
+        F64,
+        "N",
+        "normal force on the cage window faces",
+    ),
+    col(
+        "window_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the cage window faces",
+    ),
+];
+
+/// Columns of the `drive` table (drill pipe): one row per frame.
+pub const DRIVE: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "input_speed",
+        F64,
+        "rad/s",
+        "prescribed spin speed of the upper connector",
+    ),
+    col(
+        "input_torque",
+        F64,
+        "N*m",
+        "torque the drive applies to the upper connector about its axis",
+    ),
+    col(
+        "output_speed",
+        F64,
+        "rad/s",
+        "spin speed of the lower connector",
+    ),
+    col(
+        "output_torque",
+        F64,
+        "N*m",
+        "resisting moment applied to the lower connector (opposing its spin)",
+    ),
+    col("input_power", F64, "W", "input_torque × input_speed"),
+    col("output_power", F64, "W", "output_torque × output_speed"),
+    col(
+        "efficiency",
+        F64,
+        "1",
+        "output_power / input_power; 0 while the input power is not positive",
+    ),
+];
+
 /// The columns of a table.
 pub fn columns(table: TableKind) -> &'static [ColumnDef] {
     match table {
         TableKind::Bodies => BODIES,
         TableKind::Contacts => CONTACTS,
         TableKind::Energy => ENERGY,
+        TableKind::Summary => SUMMARY,
+        TableKind::Links => LINKS,
+        TableKind::Hinges => HINGES,
+        TableKind::Keys => KEYS,
+        TableKind::Drive => DRIVE,
     }
 }
 
@@ -334,7 +553,7 @@ mod tests {
 
     #[test]
     fn column_names_are_unique_within_each_table() {
-        for t in [TableKind::Bodies, TableKind::Contacts, TableKind::Energy] {
+        for t in TableKind::ALL {
             let cols = columns(t);
             for (i, c) in cols.iter().enumerate() {
                 assert!(
@@ -348,7 +567,7 @@ mod tests {
 
     #[test]
     fn every_float_column_states_a_unit() {
-        for t in [TableKind::Bodies, TableKind::Contacts, TableKind::Energy] {
+        for t in TableKind::ALL {
             for c in columns(t) {
                 if c.kind == F64 {
                     assert!(!c.unit.is_empty(), "{} has no unit", c.name);

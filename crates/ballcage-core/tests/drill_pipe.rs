@@ -1,0 +1,266 @@
+//! The drill pipe's parts against hand calculations (physics.md §7.5, §7.6, §7.9).
+
+mod common;
+
+use ballcage_core::drillpipe::DrillPipeSpec;
+use ballcage_core::{Scene, Simulation};
+
+const K_SI: f64 = 1e5 * 3.981_071_705_534_972e6; // 1e5 N/mm^2.2 in N/m^2.2 (1000^2.2 = 10^6.6)
+
+/// A link resting in a straight horizontal tube; returns (Σ normal force [N], depth per point [m], speed [m/s]).
+fn resting_link(points: u32) -> (f64, f64, f64) {
+    let toml = format!(
+        r#"
+        [simulation]
+        duration = 0.3
+        dt = 1e-5
+        output_interval = 1e-2
+        integrator = "rk4"
+        [world]
+        gravity = [0.0, 0.0, -9.8]
+        [[bodies]]
+        name = "tube"
+        motion = "fixed"
+        shape = {{ type = "tube", inner_radius = 0.058, start = [-1.0, 0.0, 0.0], direction = [1.0, 0.0, 0.0], segments = [{{ type = "straight", length = 2.0 }}] }}
+        [[bodies]]
+        name = "link"
+        shape = {{ type = "cylinder", radius = 0.043, half_length = 0.1 }}
+        mass = 8.010
+        inertia = [8.306e-3, 3.085e-2, 3.085e-2]
+        position = [0.0, 0.0, -0.015]
+        [[contacts]]
+        bodies = ["tube", "link"]
+        points = {points}
+        normal = {{ law = "impact", stiffness = 1e5, exponent = 2.2, damping = 10.0, depth_max = 0.1, units = "N-mm-s" }}
+        friction = {{ law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 100.0, v_dynamic = 1000.0, units = "N-mm-s" }}
+        "#
+    );
+    let mut sim = common::sim(&toml);
+    sim.run().unwrap();
+    let c = sim.pair_contacts(0);
+    assert_eq!(
+        c.len(),
+        points as usize,
+        "every sample of a link lying flat touches"
+    );
+    let total: f64 = c.iter().map(|e| e.normal_force).sum();
+    (total, c[0].point.depth, sim.state().vel[1].norm())
+}
+
+#[test]
+fn a_link_resting_in_a_horizontal_tube_carries_its_weight() {
+    // physics.md §7.6: Σ F_n = m g = 78.50 N whatever the sampling; δ = (m g / (N K))^(1/2.2).
+    let mg = 8.010 * 9.8;
+    for points in [2, 5, 9] {
+        let (total, depth, speed) = resting_link(points);
+        assert!(
+            ((total - mg) / mg).abs() < 1e-3,
+            "{points} points: Σ F_n = {total} N, m g = {mg} N"
+        );
+        let expect = (mg / (points as f64 * K_SI)).powf(1.0 / 2.2);
+        assert!(
+            ((depth - expect) / expect).abs() < 1e-3,
+            "{points} points: δ = {depth}, expected {expect}"
+        );
+        assert!(speed < 1e-6, "still moving at {speed} m/s");
+    }
+    // The hand value for two points: 0.0283 mm.
+    let (_, depth, _) = resting_link(2);
+    assert!(
+        (depth * 1e3 - 0.0283).abs() < 5e-5,
+        "δ = {} mm",
+        depth * 1e3
+    );
+}
+
+#[test]
+fn the_paper_scene_expands_to_its_bodies_and_pairs_and_starts_without_contact() {
+    let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &[]).unwrap();
+    // 1 tube + 2 connectors + 12 links + 13 cages + 78 keys.
+    assert_eq!(scene.bodies.len(), 106);
+    // 12 link–tube pairs; per hinge 2 cage spheres + 6 keys × (2 + 2 flanks + 2 window pairs).
+    assert_eq!(scene.contacts.len(), 12 + 13 * (2 + 6 * 6));
+    let mut sim = Simulation::new(&scene).unwrap();
+    for k in 0..scene.contacts.len() {
+        assert!(
+            sim.pair_contacts(k).is_empty(),
+            "pair {} touches at t = 0",
+            scene.contacts[k].pair_name()
+        );
+    }
+    // The default is the paper's: printing and reading back gives the same scene.
+    let again = Scene::from_toml_str(&scene.to_toml(), &[]).unwrap();
+    assert_eq!(again.bodies, scene.bodies);
+    assert_eq!(again.contacts, scene.contacts);
+}
+
+#[test]
+fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
+    let o = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    let scene = Scene::from_toml_str(
+        "kind = \"drill-pipe\"\n",
+        &o(&[
+            "pipe.joints=4",
+            "borehole.curvature_radius=2.5",
+            "drive.speed_rpm=60",
+            "load.resisting_moment=900",
+        ]),
+    )
+    .unwrap();
+    assert_eq!(
+        scene
+            .bodies
+            .iter()
+            .filter(|b| b.name.starts_with("link"))
+            .count(),
+        4
+    );
+    let spec = scene.origin.as_ref().unwrap();
+    assert_eq!(spec.borehole.curvature_radius, 2.5);
+    let upper = scene.bodies.iter().find(|b| b.name == "upper").unwrap();
+    assert!(
+        (upper.spin_speed - 2.0 * std::f64::consts::PI).abs() < 1e-12,
+        "60 rpm = 2π rad/s"
+    );
+    let e = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o(&["pipe.joints=0"])).unwrap_err();
+    assert_eq!(e.path, "pipe.joints");
+    let e = Scene::from_toml_str(
+        "kind = \"drill-pipe\"\n",
+        &o(&["borehole.curvature_radius=-1"]),
+    )
+    .unwrap_err();
+    assert_eq!(e.path, "borehole.curvature_radius");
+}
+
+/// Section model of one loaded key (physics.md §3 geometry): the loaded head
+/// flank centre sits at +a(cos α, sin α) and the seat flank centre at
+/// −a(cos α, sin α) from the ball (radial, circumferential), a = ρ_g − r_b − s.
+/// Turning the seat by u = PCR·θ moves its flank centre by u around; the ball,
+/// pressed equally by both, lies midway, each contact penetrating δ with
+/// |C_head − C_seat| = 2(a + s + δ). So cos α′ = a·cos α/(a + s + δ) and
+/// T = 6·K·δⁿ·PCR·sin α′. Returns (per-key force [N], wind-up per hinge [rad]).
+/// With s = 0 and δ ≪ a this is physics.md §7.9: T/(6·PCR·sin 45°) = 13.47 kN.
+fn section_model(torque: f64, k: f64, n: f64, s: f64) -> (f64, f64) {
+    let (pcr, alpha, rho_g, r_b) = (0.0315, std::f64::consts::FRAC_PI_4, 0.0078, 0.0075);
+    let a = rho_g - r_b - s;
+    let t_of =
+        |d: f64| 6.0 * k * d.powf(n) * pcr * (1.0 - (a * alpha.cos() / (a + s + d)).powi(2)).sqrt();
+    let (mut lo, mut hi) = (0.0, 1e-2);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if t_of(mid) < torque {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    let d = 0.5 * (lo + hi);
+    let u = (4.0 * (a + s + d).powi(2) - (2.0 * a * alpha.cos()).powi(2)).sqrt()
+        - 2.0 * a * alpha.sin();
+    (k * d.powf(n), u / pcr)
+}
+
+/// A 1-link pipe in a straight bore (two hinges in series), drive held at
+/// rest, 1.8 kN·m ramped onto the lower connector, no gravity; returns each
+/// key's (head-race, seat-race) normal force [N] and the lower connector's turn [rad].
+fn quasi_static_hinges(extra: &[&str]) -> (Vec<(f64, f64)>, f64) {
+    let mut o: Vec<String> = [
+        "pipe.joints=1",
+        "borehole.curvature_radius=1000",
+        "drive.speed_rpm=0",
+        "load.ramp=0.04",
+        "world.gravity=0",
+        "simulation.duration=0.12",
+        "simulation.dt=2e-7",
+        "simulation.output_interval=0.01",
+        "record.tables=[]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    o.extend(extra.iter().map(|s| s.to_string()));
+    let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+    let mut sim = Simulation::new(&scene).unwrap();
+    let lower = common::body(&sim, "lower");
+    let q0 = sim.state().rot[lower];
+    sim.run().unwrap();
+    let mut forces = vec![];
+    for h in 0..2 {
+        for j in 0..6 {
+            let mut race = |name: &str| -> f64 {
+                ["+", "-"]
+                    .iter()
+                    .map(|t| {
+                        let k = sim
+                            .pair_index(&format!("h{h:02}.key{j}/{name}{t}"))
+                            .unwrap();
+                        sim.pair_contacts(k)
+                            .iter()
+                            .map(|e| e.normal_force)
+                            .sum::<f64>()
+                    })
+                    .sum()
+            };
+            let head = race("head");
+            forces.push((head, race("seat")));
+        }
+    }
+    (forces, (sim.state().rot[lower] * q0.inverse()).angle())
+}
+
+#[test]
+fn one_hinge_under_quasi_static_torque_carries_13_47_kn_per_key() {
+    // physics.md §7.9's assumptions: no flank clearance, contacts stiff enough
+    // that the 45° contact angle holds (K = 1e12 N/mm^2.2: δ ≈ 0.3 µm ≪ a = 0.3 mm).
+    let (forces, _) = quasi_static_hinges(&[
+        "pipe.ball_keys.flank_clearance=0",
+        "materials.internal.normal.stiffness=1e12",
+    ]);
+    let hand = 1800.0 / (6.0 * 0.0315 * std::f64::consts::FRAC_PI_4.sin());
+    assert!((hand - 13_468.7).abs() < 1.0);
+    let mean = forces.iter().map(|(h, s)| h + s).sum::<f64>() / (2.0 * forces.len() as f64);
+    for (i, (head, seat)) in forces.iter().enumerate() {
+        for f in [head, seat] {
+            assert!(
+                ((f - hand) / hand).abs() < 0.02,
+                "key {i}: {f} N vs the hand value {hand} N"
+            );
+            assert!(
+                ((f - mean) / mean).abs() < 0.005,
+                "key {i}: {f} N vs the mean {mean} N: unequal sharing"
+            );
+        }
+    }
+    // The elastic wind-up here (2·2δ/(PCR·sin α) ≈ 0.05 mrad) is below the slack the cage and
+    // window clearances allow, so §7.9's wind-up is checked with the paper's law below.
+}
+
+#[test]
+fn with_the_paper_law_the_contact_angle_opens_and_keys_carry_less() {
+    // The paper's law is soft: at ~10 kN a key penetrates ~0.35 mm, more than the
+    // 0.29 mm flank offset of the proposed Gothic arch, so the contact angle opens
+    // from 45° toward 72° and each key carries ~10 kN, not 13.47 kN.
+    let k = 1e5 * 1000f64.powf(2.2);
+    let (forces, turned) = quasi_static_hinges(&[]);
+    let (model, per_hinge) = section_model(1800.0, k, 2.2, 1e-5);
+    assert!(model < 10_100.0 && model > 9_900.0, "section model {model}");
+    let mean = forces.iter().map(|(h, s)| h + s).sum::<f64>() / (2.0 * forces.len() as f64);
+    for (i, (head, seat)) in forces.iter().enumerate() {
+        for f in [head, seat] {
+            assert!(
+                ((f - mean) / mean).abs() < 0.01,
+                "key {i}: {f} N, mean {mean} N: unequal sharing"
+            );
+        }
+    }
+    // The 2-D section ignores the ball's radial shift and the 7.2° track offset: 3 %.
+    assert!(
+        ((mean - model) / model).abs() < 0.03,
+        "mean key force {mean} N vs section model {model} N"
+    );
+    assert!(
+        ((turned - 2.0 * per_hinge) / (2.0 * per_hinge)).abs() < 0.05,
+        "turned {turned} rad vs {}",
+        2.0 * per_hinge
+    );
+}
