@@ -151,6 +151,22 @@ def test_progress_bar_appears_only_after_the_delay():
     assert silent.getvalue() == ""
 
 
+def test_progress_bar_on_a_terminal_redraws_one_line():
+    class Terminal(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    out = Terminal()
+    bar = _ProgressBar(True, duration=0.2, stream=out, clock=lambda: 0.0)
+    for t in (0.139, 0.14, 0.2):
+        bar.update(t)
+    bar.close()
+    frames = out.getvalue().split("\r")[1:]
+    assert len(frames) == 3 and out.getvalue().count("\n") == 1
+    assert len({len(f.rstrip("\n")) for f in frames}) == 1  # a shorter line is padded over the longer one
+    assert "100%" in frames[-1]
+
+
 def test_debug_build_warns_on_import():
     with pytest.warns(RuntimeWarning, match="without optimizations"):
         ballcage._warn_if_debug_build("debug")

@@ -11,11 +11,17 @@ The pipeline is scene → simulation → tables::
 A scene is a TOML file, a dict of the same structure, or a `SceneBuilder`;
 `load_scene` validates it (in Rust) and raises `SceneError` naming the field.
 All quantities are SI; units are in each output column's field metadata.
+
+The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
+`ballcage.paper.run_paper(dir)` runs it and writes the tables, the paper's
+figures and a comparison with the paper's numbers (``ballcage paper``).
 """
 
 from __future__ import annotations
 
+import importlib
 import warnings
+from typing import Any
 
 from ballcage import _native
 from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
@@ -47,3 +53,10 @@ def _warn_if_debug_build(build_profile: str) -> None:
 
 
 _warn_if_debug_build(_native.BUILD_PROFILE)
+
+
+def __getattr__(name: str) -> Any:
+    """Imports `ballcage.paper` (and with it matplotlib) only when it is first used."""
+    if name == "paper":
+        return importlib.import_module("ballcage.paper")
+    raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

@@ -4,13 +4,29 @@ Everything here is SI: lengths in m, times in s, forces in N.
 """
 
 from collections.abc import Sequence
-from typing import Any, Literal, final
+from typing import Any, Literal, Self, final
 
 import pyarrow as pa
+
+__all__ = [
+    "__version__",
+    "BUILD_PROFILE",
+    "TABLE_NAMES",
+    "SceneError",
+    "SimulationError",
+    "Scene",
+    "Simulation",
+    "default_scene_toml",
+    "table_schema",
+]
+
+TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"]
 
 __version__: str
 #: Cargo profile the extension was built with; "debug" runs ~10x slower.
 BUILD_PROFILE: Literal["release", "debug"]
+#: Every output table name, in the order `ballcage schema` prints them.
+TABLE_NAMES: list[str]
 
 class SceneError(ValueError):
     """A scene that cannot be read or validated.
@@ -70,7 +86,7 @@ class Scene:
 class Simulation:
     """One run of a scene. Advance it, then `finish` it once."""
 
-    def __init__(self, scene: Scene) -> None: ...
+    def __new__(cls, scene: Scene) -> Self: ...
     @property
     def time(self) -> float:
         """Simulated time reached [s]."""
@@ -92,5 +108,11 @@ class Simulation:
     def finish(self) -> dict[str, pa.Table]:
         """One table per recorded table name. Callable once."""
 
-def table_schema(name: Literal["bodies", "contacts", "energy"]) -> pa.Schema:
-    """The Arrow schema of an output table; each field carries ``unit`` and ``description`` metadata."""
+def table_schema(name: TableName | str) -> pa.Schema:
+    """The Arrow schema of an output table; each field carries ``unit`` and ``description`` metadata.
+
+    Raises `ValueError` for a name not in `TABLE_NAMES`.
+    """
+
+def default_scene_toml() -> str:
+    """The embedded default scene (the paper's drill pipe, ``kind = "drill-pipe"``) as TOML, every default written out."""

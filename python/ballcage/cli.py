@@ -1,4 +1,9 @@
-"""Command line: ``ballcage run`` and ``ballcage schema``.
+"""Command line: ``ballcage run``, ``ballcage paper``, ``ballcage scene show`` and ``ballcage schema``.
+
+``ballcage run`` without a scene runs the embedded paper scene (Zhu et al.
+2023's drill pipe); ``ballcage scene show`` prints it as TOML to copy and edit.
+``ballcage paper`` runs it with every table recorded and writes the paper's
+figures and a comparison with its numbers (`ballcage.paper.run_paper`).
 
 Exit codes: 0 success; 1 the run failed (`SimulationError`) or its output could
 not be written; 2 bad input (an invalid scene, a missing file, a malformed
@@ -16,13 +21,15 @@ from typing import NoReturn
 
 from ballcage import _native
 from ballcage.run import simulate
-from ballcage.scene import SceneSource, load_scene
+from ballcage.scene import SceneSource, default_scene, load_scene
 
 __all__ = ["main"]
 
 PROG = "ballcage"
 #: Output tables, in the order `ballcage schema` prints them.
-TABLE_NAMES = ("bodies", "contacts", "energy")
+TABLE_NAMES: tuple[str, ...] = tuple(_native.TABLE_NAMES)
+#: What `ballcage run` names the embedded scene in messages.
+DEFAULT_SCENE_NAME = "default scene"
 
 
 class UsageError(Exception):
@@ -61,19 +68,48 @@ def _build_parser() -> argparse.ArgumentParser:
         help="simulate a scene and write Parquet tables",
         description="Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml.",
     )
-    # To make SCENE optional later: nargs="?", and let _scene_source() supply the default scene.
-    run.add_argument("scene", metavar="SCENE.toml", help="scene file (TOML)")
-    run.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
     run.add_argument(
-        "--set",
-        metavar="KEY=VALUE",
-        action="append",
-        default=[],
-        dest="overrides",
-        help="override a scene field, e.g. --set simulation.duration=0.1 --set bodies.1.mass=2 (value is TOML)",
+        "scene",
+        metavar="SCENE.toml",
+        nargs="?",
+        help="scene file (TOML); without it, the embedded paper scene (see `ballcage scene show`)",
     )
+    run.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_set_option(run)
     run.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     run.set_defaults(command=_run)
+
+    paper = commands.add_parser(
+        "paper",
+        help="run the paper's scene; write tables, the paper's figures and a comparison",
+        description=(
+            "Run the embedded paper scene (Zhu et al., Machines 2023) recording every table; write "
+            "<table>.parquet, scene.toml, the figures fig09-fig13 and table3_shape as PNG, and "
+            "comparison.parquet / comparison.md against the paper's numbers. The full run takes minutes."
+        ),
+    )
+    paper.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_set_option(paper, example="--set simulation.duration=0.2 --set drive.speed_rpm=60")
+    paper.add_argument(
+        "--sweeps",
+        action="store_true",
+        help="also run the R = 1.0 / 2.5 m and 60 / 120 rpm variants (4 more runs) and fill the sweep rows",
+    )
+    paper.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    paper.set_defaults(command=_paper)
+
+    scene = commands.add_parser(
+        "scene",
+        help="the embedded default scene",
+        description="Work with the embedded default scene (the paper's drill pipe).",
+    )
+    scene_commands = scene.add_subparsers(title="commands", required=True, metavar="COMMAND", parser_class=_Parser)
+    show = scene_commands.add_parser(
+        "show",
+        help="print the default scene as TOML",
+        description="Print the default scene as TOML, every default written out: copy it, edit it, run it.",
+    )
+    show.set_defaults(command=_scene_show)
 
     schema = commands.add_parser(
         "schema",
@@ -85,16 +121,35 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _run(args: argparse.Namespace) -> int:
-    overrides = [_checked_override(o) for o in args.overrides]
-    out: Path = args.out
+def _add_set_option(parser: argparse.ArgumentParser, example: str | None = None) -> None:
+    example = example or "--set simulation.duration=0.1 --set bodies.1.mass=2"
+    parser.add_argument(
+        "--set",
+        metavar="KEY=VALUE",
+        action="append",
+        default=[],
+        dest="overrides",
+        help=f"override a scene field, e.g. {example} (value is TOML)",
+    )
+
+
+def _checked_out(out: Path) -> Path:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out} exists and is not a directory")
+    return out
+
+
+def _run(args: argparse.Namespace) -> int:
+    overrides = [_checked_override(o) for o in args.overrides]
+    out = _checked_out(args.out)
     source = _scene_source(args.scene)
     try:
-        scene = load_scene(source, overrides)
+        if source is None:
+            scene = default_scene(overrides)
+        else:
+            scene = load_scene(source, overrides)
     except _native.SceneError as e:
-        raise UsageError(f"{source}: {e}") from e
+        raise UsageError(f"{source or DEFAULT_SCENE_NAME}: {e}") from e
     except OSError as e:  # missing, a directory, unreadable
         raise UsageError(f"{e.strerror or e}: {e.filename or source}") from e
     except UnicodeDecodeError as e:
@@ -107,11 +162,42 @@ def _run(args: argparse.Namespace) -> int:
     return 0
 
 
-def _scene_source(arg: str | None) -> SceneSource:
-    """The scene named on the command line (a default scene can be supplied here)."""
-    if arg is None:
-        raise UsageError("no scene given")
+def _scene_source(arg: str | None) -> SceneSource | None:
+    """The scene named on the command line; ``None`` for the embedded default scene."""
     return arg
+
+
+def _paper(args: argparse.Namespace) -> int:
+    from ballcage.paper import run_paper  # deferred: imports matplotlib
+
+    overrides = [_checked_override(o) for o in args.overrides]
+    out = _checked_out(args.out)
+    try:
+        paths = run_paper(out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None)
+    except _native.SceneError as e:
+        raise UsageError(f"{DEFAULT_SCENE_NAME}: {e}") from e
+    if not args.quiet:
+        for name, path in paths.items():
+            print(_paper_summary(name, path))
+    return 0
+
+
+def _paper_summary(name: str, path: Path) -> str:
+    if path.is_dir():
+        return f"wrote {path}/  (sweep variant {name.removeprefix('sweep_')})"
+    if path.suffix == ".parquet":
+        import pyarrow.parquet as pq
+
+        meta = pq.ParquetFile(path).metadata
+        return f"wrote {path}  ({meta.num_rows} rows x {meta.num_columns} columns, {_human_size(path.stat().st_size)})"
+    what = {"scene": "resolved scene", "comparison_md": "comparison"}.get(name, "figure" if path.suffix == ".png" else name)
+    return f"wrote {path}  ({what}, {_human_size(path.stat().st_size)})"
+
+
+def _scene_show(args: argparse.Namespace) -> int:
+    text = _native.default_scene_toml()
+    sys.stdout.write(text if text.endswith("\n") else text + "\n")
+    return 0
 
 
 def _checked_override(text: str) -> str:

@@ -84,7 +84,11 @@ class Run:
         written: dict[str, Path] = {}
         for name, table in self.tables.items():
             path = out / f"{name}.parquet"
-            _write_atomically(path, lambda tmp, t=table: pq.write_table(t, str(tmp), compression="zstd"))
+
+            def write_parquet(tmp: Path, table: pa.Table = table) -> None:
+                pq.write_table(table, str(tmp), compression="zstd")
+
+            _write_atomically(path, write_parquet)
             written[name] = path
         scene_path = out / "scene.toml"
         _write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
@@ -159,6 +163,7 @@ class _ProgressBar:
         self._shown = False
         self._tty = _isatty(self._stream)
         self._last_decile = 0  # the first line is at 10 %
+        self._width = 0
 
     def update(self, t: float) -> None:
         if self._mode is False:
@@ -172,9 +177,9 @@ class _ProgressBar:
         if self._tty:
             filled = round(fraction * self.WIDTH)
             bar = "#" * filled + "." * (self.WIDTH - filled)
-            self._stream.write(
-                f"\rballcage: [{bar}] {fraction:4.0%}  t = {t:.4g} / {self._duration:.4g} s  {elapsed:.1f} s"
-            )
+            line = f"ballcage: [{bar}] {fraction:4.0%}  t = {t:.4g} / {self._duration:.4g} s  {elapsed:.1f} s"
+            self._width = max(self._width, len(line))
+            self._stream.write("\r" + line.ljust(self._width))  # pad over a longer previous line
             self._stream.flush()
         else:
             decile = int(fraction * 10 + 1e-9)

@@ -7,6 +7,10 @@ There is one way in for each kind of source:
 - a `SceneBuilder`, which emits such a dict,
 - an already validated `ballcage.Scene`.
 
+`default_scene` is the embedded paper scene (Zhu et al. 2023's drill pipe):
+its overrides are applied to the short drill-pipe TOML, so keys such as
+``drive.speed_rpm`` or ``borehole.curvature_radius`` work there.
+
 Every route ends in the same Rust validator, so a scene written as TOML and
 the same scene built in Python produce bitwise identical runs.
 """
@@ -22,7 +26,7 @@ from typing import Any, Self, TypeAlias
 
 from ballcage import _native
 
-__all__ = ["SceneBuilder", "SceneSource", "load_scene"]
+__all__ = ["SceneBuilder", "SceneSource", "default_scene", "default_scene_toml", "load_scene"]
 
 
 class SceneBuilder:
@@ -141,6 +145,23 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
         f"cannot load a scene from {type(source).__name__}: give a path to a TOML file, "
         "a dict, a SceneBuilder or a ballcage.Scene"
     )
+
+
+def default_scene_toml() -> str:
+    """The embedded default scene (the paper's drill pipe) as TOML, every default written out."""
+    return _native.default_scene_toml()
+
+
+def default_scene(overrides: Iterable[str] = ()) -> _native.Scene:
+    """The embedded paper scene, validated, with ``dotted.key=value`` `overrides` applied.
+
+    The overrides address the drill-pipe TOML of `default_scene_toml`
+    (``"drive.speed_rpm=60"``, ``"simulation.duration=0.02"``), not the
+    expanded scene that ``Scene.to_toml()`` returns. Raises `ballcage.SceneError`.
+    """
+    if isinstance(overrides, str):
+        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+    return _native.Scene.from_toml(_native.default_scene_toml(), list(overrides))
 
 
 def _read_scene_file(source: str | os.PathLike[str]) -> str:

@@ -1,10 +1,13 @@
 //! Scene → model and initial state, keeping only what the scene declares.
 
 use crate::error::SceneError;
+use crate::force::joint::CvJointParams;
 use crate::geometry::Shape;
 use crate::math::{Quat, Vec3};
-use crate::model::{Body, ContactPair, Model, Motion, RecordPlan, SpinProfile, State, TorqueLoad};
-use crate::scene::{LoadSpec, MotionKind, Scene};
+use crate::model::{
+    Body, ContactPair, Joint, Model, Motion, RecordPlan, SpinProfile, State, TorqueLoad,
+};
+use crate::scene::{JointSpec, LoadSpec, MotionKind, Scene};
 
 /// Builds the model and initial state of a scene (validating it first).
 pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
@@ -103,6 +106,59 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
         })
         .collect();
 
+    let joints = scene
+        .joints
+        .iter()
+        .enumerate()
+        .map(|(i, j)| match j {
+            JointSpec::Cv {
+                name,
+                bodies: names,
+                anchors,
+                stiffness,
+                damping,
+                twist_stiffness,
+                twist_damping,
+                bend_limit_deg,
+                stop_stiffness,
+            } => Joint {
+                name: name.clone().unwrap_or_else(|| format!("joints[{i}]")),
+                a: scene.body_index(&names[0]).unwrap_or_default(),
+                b: scene.body_index(&names[1]).unwrap_or_default(),
+                anchor_a: Vec3::from(anchors[0]),
+                anchor_b: Vec3::from(anchors[1]),
+                params: CvJointParams {
+                    stiffness: *stiffness,
+                    damping: *damping,
+                    twist_stiffness: *twist_stiffness,
+                    twist_damping: *twist_damping,
+                    bend_limit: bend_limit_deg.to_radians(),
+                    stop_stiffness: *stop_stiffness,
+                },
+            },
+            JointSpec::BendStop {
+                name,
+                bodies: names,
+                bend_limit_deg,
+                stop_stiffness,
+            } => Joint {
+                name: name.clone().unwrap_or_else(|| format!("joints[{i}]")),
+                a: scene.body_index(&names[0]).unwrap_or_default(),
+                b: scene.body_index(&names[1]).unwrap_or_default(),
+                anchor_a: Vec3::zeros(),
+                anchor_b: Vec3::zeros(),
+                params: CvJointParams {
+                    stiffness: 0.0,
+                    damping: 0.0,
+                    twist_stiffness: 0.0,
+                    twist_damping: 0.0,
+                    bend_limit: bend_limit_deg.to_radians(),
+                    stop_stiffness: *stop_stiffness,
+                },
+            },
+        })
+        .collect();
+
     let record = RecordPlan {
         tables: scene.record.tables.clone(),
         bodies: if scene.record.bodies.is_empty() {
@@ -161,6 +217,7 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
         integrated,
         pairs,
         torques,
+        joints,
         gravity: Vec3::from(scene.world.gravity),
         integrator: scene.simulation.integrator,
         dt: scene.simulation.dt,

@@ -2,15 +2,17 @@
 //!
 //! Stages of one evaluation, in order:
 //! 1. applied loads (gravity, torques) — depend on time only;
-//! 2. contact forces of the declared pairs — depend on poses and velocities;
-//! 3. accelerations: Newton for translation, Euler's equations with the
+//! 2. joint forces of the declared joints — depend on poses and velocities;
+//! 3. contact forces of the declared pairs — depend on poses and velocities;
+//! 4. accelerations: Newton for translation, Euler's equations with the
 //!    gyroscopic term for rotation (body frame), projected onto the spin axis
 //!    for `spin` bodies.
 
 use crate::force::friction_force;
+use crate::force::joint::cv_joint_wrench;
 use crate::geometry::ContactPoint;
-use crate::math::Vec3;
-use crate::model::{ContactPair, Model, Motion, State};
+use crate::math::{Mat3, Vec3};
+use crate::model::{ContactPair, Joint, Model, Motion, State};
 
 /// Accelerations of every body (zero for bodies that are not integrated).
 #[derive(Debug, Clone, PartialEq)]
@@ -111,6 +113,44 @@ impl Dynamics {
 
     /// Accelerations of all bodies at `state`.
     pub fn accelerations(&mut self, model: &Model, state: &State, mode: Mode, acc: &mut Accel) {
+        self.loads_joints_contacts(model, state, mode, None);
+        // 4. accelerations
+        for &i in &model.integrated {
+            let b = &model.bodies[i];
+            let w = state.omega[i];
+            match b.motion {
+                Motion::Dynamic => {
+                    acc.lin[i] = self.force[i] / b.mass;
+                    let tau_b = state.rot[i].inverse() * self.torque[i];
+                    let iw = b.inertia.component_mul(&w);
+                    acc.ang[i] = (tau_b - w.cross(&iw)).component_div(&b.inertia);
+                }
+                Motion::Spin {
+                    axis,
+                    axis_body,
+                    inertia,
+                } => {
+                    acc.lin[i] = Vec3::zeros();
+                    acc.ang[i] = axis_body * (self.torque[i].dot(&axis) / inertia);
+                }
+                Motion::Fixed | Motion::KinematicSpin(_) => {}
+            }
+        }
+    }
+
+    /// Stages 1–3 of an evaluation: net force and torque on every integrated
+    /// body (world frame, torques about the centres of mass, no gyroscopic
+    /// term); with `jac`, also their velocity Jacobian.
+    fn loads_joints_contacts(
+        &mut self,
+        model: &Model,
+        state: &State,
+        mode: Mode,
+        mut jac: Option<&mut VelocityJacobian>,
+    ) {
+        if let Some(jac) = jac.as_deref_mut() {
+            jac.clear();
+        }
         self.evaluations += 1;
         // 1. applied loads
         for &i in &model.integrated {
@@ -120,7 +160,32 @@ impl Dynamics {
         for l in &model.torques {
             self.torque[l.body] += l.torque(state.t);
         }
-        // 2. contacts
+        // 2. joints
+        for (n, j) in model.joints.iter().enumerate() {
+            let (a, b) = (j.a, j.b);
+            let (ra, rb) = (state.rot[a] * j.anchor_a, state.rot[b] * j.anchor_b);
+            let (pa, pb) = (state.pos[a] + ra, state.pos[b] + rb);
+            let (wa, wb) = (state.omega_world(a), state.omega_world(b));
+            let w = cv_joint_wrench(
+                &state.rot[a],
+                &state.rot[b],
+                &pa,
+                &pb,
+                &(state.vel[a] + wa.cross(&ra)),
+                &(state.vel[b] + wb.cross(&rb)),
+                &wa,
+                &wb,
+                &j.params,
+            );
+            self.force[b] += w.force;
+            self.torque[b] += rb.cross(&w.force) + w.torque;
+            self.force[a] -= w.force;
+            self.torque[a] -= ra.cross(&w.force) + w.torque;
+            if let Some(jac) = jac.as_deref_mut() {
+                jac.add_joint(model.pairs.len() + n, j, state, &ra, &rb);
+            }
+        }
+        // 3. contacts
         for k in 0..model.pairs.len() {
             let pair = &model.pairs[k];
             let mut points = std::mem::take(&mut self.points);
@@ -145,38 +210,51 @@ impl Dynamics {
                 }
             }
             for p in &points {
-                let e = evaluate_point(state, pair, p, &self.latched[k]);
+                let (e, d) = evaluate_point_full(state, pair, p, &self.latched[k]);
                 let f = e.point.normal * e.normal_force + e.tangential_force;
                 let (a, b) = (pair.a, pair.b);
                 self.force[b] += f;
                 self.torque[b] += (p.point - state.pos[b]).cross(&f);
                 self.force[a] -= f;
                 self.torque[a] -= (p.point - state.pos[a]).cross(&f);
+                if let Some(jac) = jac.as_deref_mut() {
+                    jac.add_contact_point(k, state, pair, &e, &d);
+                }
             }
             self.points = points;
         }
-        // 3. accelerations
-        for &i in &model.integrated {
-            let b = &model.bodies[i];
-            let w = state.omega[i];
-            match b.motion {
-                Motion::Dynamic => {
-                    acc.lin[i] = self.force[i] / b.mass;
-                    let tau_b = state.rot[i].inverse() * self.torque[i];
-                    let iw = b.inertia.component_mul(&w);
-                    acc.ang[i] = (tau_b - w.cross(&iw)).component_div(&b.inertia);
-                }
-                Motion::Spin {
-                    axis,
-                    axis_body,
-                    inertia,
-                } => {
-                    acc.lin[i] = Vec3::zeros();
-                    acc.ang[i] = axis_body * (self.torque[i].dot(&axis) / inertia);
-                }
-                Motion::Fixed | Motion::KinematicSpin(_) => {}
-            }
-        }
+    }
+
+    /// Forces and their velocity Jacobian at `state`, for implicit integrators.
+    ///
+    /// One force evaluation through the same path as
+    /// [`Dynamics::accelerations`] (same loads, joints, contact points and
+    /// laws, same latching in [`Mode::Commit`]); it leaves the net force and
+    /// torque on every integrated body in [`Dynamics::forces`] and
+    /// [`Dynamics::torques`] (no gyroscopic term) and fills `jac` with
+    /// D = ∂(wrench)/∂(twist) of the velocity-dependent joint and contact
+    /// forces, the geometry (points, normals, depths, joint axes) and latched
+    /// approach speeds held fixed. See [`VelocityJacobian`] for the layout.
+    pub fn forces_and_jacobian(
+        &mut self,
+        model: &Model,
+        state: &State,
+        mode: Mode,
+        jac: &mut VelocityJacobian,
+    ) {
+        self.loads_joints_contacts(model, state, mode, Some(jac));
+    }
+
+    /// Net force on each body [N], world frame, from the last evaluation.
+    /// Only the entries of integrated bodies are meaningful.
+    pub fn forces(&self) -> &[Vec3] {
+        &self.force
+    }
+
+    /// Net torque on each body about its centre of mass [N·m], world frame,
+    /// from the last evaluation; see [`Dynamics::forces`].
+    pub fn torques(&self) -> &[Vec3] {
+        &self.torque
     }
 
     /// Evaluates the contact points of pair `k` at `state` without touching
@@ -265,6 +343,26 @@ fn evaluate_point(
     p: &ContactPoint,
     latched: &[Option<f64>],
 ) -> ContactEval {
+    evaluate_point_full(state, pair, p, latched).0
+}
+
+/// Velocity derivatives of one contact point's forces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PointDerivatives {
+    /// ∂F_n/∂δ̇ [N·s/m] of the normal law.
+    d_rate: f64,
+    /// ∂F_t/∂v_t [N·s/m] of the friction law at fixed F_n.
+    friction: Mat3,
+}
+
+/// The per-point laws: forces and their velocity derivatives.
+#[inline]
+fn evaluate_point_full(
+    state: &State,
+    pair: &ContactPair,
+    p: &ContactPoint,
+    latched: &[Option<f64>],
+) -> (ContactEval, PointDerivatives) {
     let rel = relative_velocity(state, pair, p);
     let rate = -rel.dot(&p.normal);
     let approach = latched
@@ -272,21 +370,208 @@ fn evaluate_point(
         .copied()
         .flatten()
         .unwrap_or(rate);
-    let fnormal = pair.normal.evaluate(p.depth, rate, approach).force;
+    let normal = pair.normal.evaluate(p.depth, rate, approach);
+    let fnormal = normal.force;
     let slip = rel + rate * p.normal;
     let slip_speed = slip.norm();
-    let tangential = match &pair.friction {
+    let (tangential, friction) = match &pair.friction {
         Some(law) if fnormal > 0.0 => {
-            let (f, _) = friction_force([slip.x, slip.y, slip.z], fnormal, |s| law.coefficient(s));
-            Vec3::from(f)
+            let (f, j) = friction_force([slip.x, slip.y, slip.z], fnormal, |s| law.coefficient(s));
+            (Vec3::from(f), Mat3::from_fn(|r, c| j[r][c]))
         }
-        _ => Vec3::zeros(),
+        _ => (Vec3::zeros(), Mat3::zeros()),
     };
-    ContactEval {
-        point: *p,
-        depth_rate: rate,
-        normal_force: fnormal,
-        tangential_force: tangential,
-        slip_speed,
+    (
+        ContactEval {
+            point: *p,
+            depth_rate: rate,
+            normal_force: fnormal,
+            tangential_force: tangential,
+            slip_speed,
+        },
+        PointDerivatives {
+            d_rate: normal.d_rate,
+            friction,
+        },
+    )
+}
+
+/// A 6×6 block of a velocity Jacobian.
+pub type Mat6 = nalgebra::Matrix6<f64>;
+
+/// Velocity Jacobian of the forces between two bodies a and b (a contact
+/// pair or a joint): `xy` = ∂(wrench on x)/∂(twist of y).
+///
+/// A twist is [v; ω] (centre-of-mass velocity [m/s], angular velocity
+/// [rad/s], both world frame) and a wrench [F; τ] (force [N], torque about
+/// the centre of mass [N·m], both world frame).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CouplingJacobian {
+    /// Body a.
+    pub a: usize,
+    /// Body b.
+    pub b: usize,
+    /// Whether any velocity-dependent force acted at the last evaluation
+    /// (the blocks are zero otherwise).
+    pub active: bool,
+    /// ∂(wrench on a)/∂(twist of a).
+    pub aa: Mat6,
+    /// ∂(wrench on a)/∂(twist of b).
+    pub ab: Mat6,
+    /// ∂(wrench on b)/∂(twist of a).
+    pub ba: Mat6,
+    /// ∂(wrench on b)/∂(twist of b).
+    pub bb: Mat6,
+}
+
+/// D = ∂f/∂(twist): the velocity Jacobian of all joint and contact forces,
+/// in 6×6 blocks. The sparsity pattern is fixed by the model: entry `k` of
+/// [`VelocityJacobian::couplings`] is contact pair `k` for
+/// `k < model.pairs.len()`, then joint `k − model.pairs.len()`.
+///
+/// A contact point p between a and b with arms r_i = p − x_i has the 3×3
+/// gradient G = ∂F_b/∂v_rel of the force on b with respect to the relative
+/// point velocity v_rel = (v_b + ω_b × r_b) − (v_a + ω_a × r_a); with the
+/// point-velocity map J_i = [I, −[r_i]×] and the wrench map
+/// W_i = [I; [r_i]×] it adds D_bb += W_b G J_b, D_ba −= W_b G J_a,
+/// D_ab −= W_a G J_b, D_aa += W_a G J_a.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VelocityJacobian {
+    /// One entry per contact pair, then one per joint.
+    pub couplings: Vec<CouplingJacobian>,
+}
+
+impl VelocityJacobian {
+    /// Zero blocks shaped for `model`.
+    pub fn new(model: &Model) -> Self {
+        let ends = model
+            .pairs
+            .iter()
+            .map(|p| (p.a, p.b))
+            .chain(model.joints.iter().map(|j| (j.a, j.b)));
+        Self {
+            couplings: ends
+                .map(|(a, b)| CouplingJacobian {
+                    a,
+                    b,
+                    active: false,
+                    aa: Mat6::zeros(),
+                    ab: Mat6::zeros(),
+                    ba: Mat6::zeros(),
+                    bb: Mat6::zeros(),
+                })
+                .collect(),
+        }
     }
+
+    /// Zeroes every block.
+    pub fn clear(&mut self) {
+        for c in &mut self.couplings {
+            if c.active {
+                c.active = false;
+                c.aa.fill(0.0);
+                c.ab.fill(0.0);
+                c.ba.fill(0.0);
+                c.bb.fill(0.0);
+            }
+        }
+    }
+
+    /// The dense 6n × 6n matrix over all `n_bodies` bodies' twists (body i
+    /// at rows and columns 6i..6i+6), for tests and inspection.
+    pub fn to_dense(&self, n_bodies: usize) -> nalgebra::DMatrix<f64> {
+        let mut d = nalgebra::DMatrix::zeros(6 * n_bodies, 6 * n_bodies);
+        for c in self.couplings.iter().filter(|c| c.active) {
+            for (i, j, m) in [
+                (c.a, c.a, &c.aa),
+                (c.a, c.b, &c.ab),
+                (c.b, c.a, &c.ba),
+                (c.b, c.b, &c.bb),
+            ] {
+                let mut v = d.view_mut((6 * i, 6 * j), (6, 6));
+                v += m;
+            }
+        }
+        d
+    }
+
+    /// Adds the blocks of force G·v_rel acting on b at arm `r_b` (and its
+    /// reaction on a at arm `r_a`), v_rel the velocity of b's point relative
+    /// to a's.
+    fn add_gradient(&mut self, k: usize, g: &Mat3, r_a: &Vec3, r_b: &Vec3) {
+        let c = &mut self.couplings[k];
+        c.active = true;
+        c.bb += wrench_twist_block(r_b, g, r_b);
+        c.ba -= wrench_twist_block(r_b, g, r_a);
+        c.ab -= wrench_twist_block(r_a, g, r_b);
+        c.aa += wrench_twist_block(r_a, g, r_a);
+    }
+
+    fn add_contact_point(
+        &mut self,
+        k: usize,
+        state: &State,
+        pair: &ContactPair,
+        e: &ContactEval,
+        d: &PointDerivatives,
+    ) {
+        let g = contact_velocity_gradient(e, d);
+        if g != Mat3::zeros() {
+            let p = e.point.point;
+            self.add_gradient(k, &g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
+        }
+    }
+
+    /// The joint's dampers: −c·(v_b(p_b) − v_a(p_a)) at the hinge points
+    /// (arms `ra`, `rb`) and −c_t·(ê·(ω_b − ω_a))·ê on b about the mean x
+    /// axis ê (the axis of [`cv_joint_wrench`]).
+    fn add_joint(&mut self, k: usize, j: &Joint, state: &State, ra: &Vec3, rb: &Vec3) {
+        let p = &j.params;
+        if p.damping != 0.0 {
+            self.add_gradient(k, &(-p.damping * Mat3::identity()), ra, rb);
+        }
+        if p.twist_damping != 0.0 {
+            let (ea, eb) = (state.rot[j.a] * Vec3::x(), state.rot[j.b] * Vec3::x());
+            let axis = (ea + eb).try_normalize(1e-12).unwrap_or(ea);
+            let t = p.twist_damping * axis * axis.transpose();
+            let c = &mut self.couplings[k];
+            c.active = true;
+            let add = |m: &mut Mat6, sign: f64| {
+                let mut v = m.fixed_view_mut::<3, 3>(3, 3);
+                v += sign * t;
+            };
+            add(&mut c.bb, -1.0);
+            add(&mut c.ba, 1.0);
+            add(&mut c.ab, 1.0);
+            add(&mut c.aa, -1.0);
+        }
+    }
+}
+
+/// G = ∂F_b/∂v_rel [N·s/m] of the total force on b (F_n·n + F_t) at fixed
+/// geometry: the normal law through δ̇ = −n·v_rel, the friction law through
+/// the slip v_t = (I − nnᵀ)·v_rel and through F_n (F_t is proportional to
+/// F_n, so ∂F_t/∂F_n = F_t/F_n).
+fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives) -> Mat3 {
+    let n = e.point.normal;
+    let mut g = d.friction * (Mat3::identity() - n * n.transpose());
+    if e.normal_force > 0.0 && d.d_rate != 0.0 {
+        let along = n + e.tangential_force / e.normal_force;
+        g -= d.d_rate * along * n.transpose();
+    }
+    g
+}
+
+/// W_i·G·J_j: the wrench on body i (force G·u at arm r_i) per unit twist of
+/// body j (u the velocity of j's point at arm r_j). With R = [r]×:
+/// [[G, −G·R_j], [R_i·G, −R_i·G·R_j]].
+fn wrench_twist_block(r_i: &Vec3, g: &Mat3, r_j: &Vec3) -> Mat6 {
+    let ri = r_i.cross_matrix();
+    let g_rj = g * r_j.cross_matrix();
+    let mut m = Mat6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(g);
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_rj));
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(ri * g));
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&(-(ri * g_rj)));
+    m
 }

@@ -137,6 +137,23 @@ impl TorqueLoad {
     }
 }
 
+/// An ideal constant-velocity joint between bodies a and b.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Name in messages.
+    pub name: String,
+    /// Body a.
+    pub a: usize,
+    /// Body b.
+    pub b: usize,
+    /// Hinge point in a's frame [m].
+    pub anchor_a: Vec3,
+    /// Hinge point in b's frame [m].
+    pub anchor_b: Vec3,
+    /// Parameters.
+    pub params: crate::force::joint::CvJointParams,
+}
+
 /// What the recorder keeps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordPlan {
@@ -161,6 +178,8 @@ pub struct Model {
     pub pairs: Vec<ContactPair>,
     /// Applied torques.
     pub torques: Vec<TorqueLoad>,
+    /// Penalty joints.
+    pub joints: Vec<Joint>,
     /// Gravity [m/s²], world frame.
     pub gravity: Vec3,
     /// Integrator.

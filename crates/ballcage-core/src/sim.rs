@@ -69,6 +69,11 @@ impl Simulation {
         self.dynamics.evaluations
     }
 
+    /// Sparse linear solves so far (zero for the explicit integrators).
+    pub fn linear_solves(&self) -> u64 {
+        self.workspace.linear_solves()
+    }
+
     /// Whether the scene's duration has been reached.
     pub fn is_done(&self) -> bool {
         self.step >= self.model.total_steps

@@ -31,7 +31,7 @@ pub struct HingeLayout {
 pub struct Layout {
     /// Bodies in chain order: upper connector, links 1…N, lower connector.
     pub chain: Vec<usize>,
-    /// Hinges 0…N (empty without ball keys).
+    /// Hinges 0…N (without ball keys: no cage pairs and no keys).
     pub hinges: Vec<HingeLayout>,
     /// The tube centreline extended straight past the arc [m].
     pub centreline: TubePath,
@@ -68,7 +68,6 @@ impl Layout {
                     .filter(|k| !k.inner.is_empty())
                     .collect(),
             })
-            .filter(|h| !h.keys.is_empty())
             .collect();
         Self {
             chain,

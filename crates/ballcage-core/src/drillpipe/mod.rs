@@ -23,9 +23,9 @@ use crate::error::SceneError;
 use crate::geometry::TubePath;
 use crate::math::{Mat3, Quat, Vec3};
 use crate::scene::{
-    BodySpec, ContactSpec, FeatureSpec, FrictionLawSpec, IntegratorKind, LoadSpec, MotionKind,
-    NormalLawSpec, RecordSpec, Scene, ShapeSpec, SimulationSpec, TubeSegmentSpec, WorldSpec,
-    positive,
+    BodySpec, ContactSpec, FeatureSpec, FrictionLawSpec, IntegratorKind, JointSpec, LoadSpec,
+    MotionKind, NormalLawSpec, RecordSpec, Scene, ShapeSpec, SimulationSpec, TubeSegmentSpec,
+    WorldSpec, positive,
 };
 use cv::CvGeometry;
 
@@ -96,6 +96,10 @@ pub struct BallKeySpec {
     pub window_axial_width: f64,
     /// Window length around the cage [m]. PROPOSAL: 16.1 mm.
     pub window_length: f64,
+    /// Articulation stop (head–seat cone contact) [deg]. PROPOSAL: 15.
+    pub bend_limit_deg: f64,
+    /// Stop stiffness [N·m/rad]. PROPOSAL: 1e6.
+    pub stop_stiffness: f64,
 }
 
 impl Default for BallKeySpec {
@@ -116,6 +120,39 @@ impl Default for BallKeySpec {
             cage_inertia: [5.1e-5, 3.2e-5, 3.2e-5],
             window_axial_width: 0.01503,
             window_length: 0.0161,
+            bend_limit_deg: 15.0,
+            stop_stiffness: 1e6,
+        }
+    }
+}
+
+/// Ideal constant-velocity hinge: penalty joint parameters [SI, deg].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IdealCvSpec {
+    /// Hinge-point spring [N/m]. PROPOSAL: 1e9 (0.03 mm under the 1.2 kN hinge shear).
+    pub stiffness: f64,
+    /// Hinge-point damper [N·s/m]. PROPOSAL: 1.3e5 (about critical for two 8 kg links).
+    pub damping: f64,
+    /// Twist spring [N·m/rad]. PROPOSAL: 1.1e5, the ball-key hinge's tangent stiffness at 1.8 kN·m (physics.md §7.9).
+    pub twist_stiffness: f64,
+    /// Twist damper [N·m·s/rad]. PROPOSAL: 60 (about critical for a link's spin inertia).
+    pub twist_damping: f64,
+    /// Articulation stop [deg]. PROPOSAL: 15.
+    pub bend_limit_deg: f64,
+    /// Stop spring [N·m/rad]. PROPOSAL: 1e6.
+    pub stop_stiffness: f64,
+}
+
+impl Default for IdealCvSpec {
+    fn default() -> Self {
+        Self {
+            stiffness: 1e9,
+            damping: 1.3e5,
+            twist_stiffness: 1.1e5,
+            twist_damping: 60.0,
+            bend_limit_deg: 15.0,
+            stop_stiffness: 1e6,
         }
     }
 }
@@ -148,6 +185,8 @@ pub struct PipeSpec {
     pub tube_contact_points: u32,
     /// Ball-cage joint details (used by `hinge = "ball-keys"`).
     pub ball_keys: BallKeySpec,
+    /// Ideal CV joint details (used by `hinge = "ideal-cv"`).
+    pub ideal_cv: IdealCvSpec,
 }
 
 impl Default for PipeSpec {
@@ -165,6 +204,7 @@ impl Default for PipeSpec {
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
             tube_contact_points: 5,
             ball_keys: BallKeySpec::default(),
+            ideal_cv: IdealCvSpec::default(),
         }
     }
 }
@@ -412,13 +452,17 @@ impl DrillPipeSpec {
         crate::scene::finite("load.resisting_moment", self.load.resisting_moment)?;
         crate::scene::non_negative("load.ramp", self.load.ramp)?;
         crate::scene::finite("world.gravity", self.world.gravity)?;
-        if p.hinge == HingeModel::IdealCv {
-            return Err(SceneError::new(
-                "pipe.hinge",
-                "ideal-cv",
-                "the ideal-cv hinge is not available in this version; use \"ball-keys\"",
-            ));
+        let cv = &p.ideal_cv;
+        for (name, v) in [
+            ("stiffness", cv.stiffness),
+            ("twist_stiffness", cv.twist_stiffness),
+            ("bend_limit_deg", cv.bend_limit_deg),
+            ("stop_stiffness", cv.stop_stiffness),
+        ] {
+            positive(&format!("pipe.ideal_cv.{name}"), v)?;
         }
+        crate::scene::non_negative("pipe.ideal_cv.damping", cv.damping)?;
+        crate::scene::non_negative("pipe.ideal_cv.twist_damping", cv.twist_damping)?;
         let k = &p.ball_keys;
         for (name, v) in [
             ("ball_radius", k.ball_radius),
@@ -434,6 +478,8 @@ impl DrillPipeSpec {
             ("cage_mass", k.cage_mass),
             ("window_axial_width", k.window_axial_width),
             ("window_length", k.window_length),
+            ("bend_limit_deg", k.bend_limit_deg),
+            ("stop_stiffness", k.stop_stiffness),
         ] {
             positive(&format!("pipe.ball_keys.{name}"), v)?;
         }
@@ -572,6 +618,13 @@ impl DrillPipeSpec {
             axes[0],
             MotionKind::KinematicSpin,
         ));
+        // The reduced model keeps the chain's mass: each link carries one hinge's
+        // cage and keys (half of each of its two hinges).
+        let hinge_parts = if p.hinge == HingeModel::IdealCv {
+            p.ball_keys.cage_mass + 6.0 * p.ball_keys.ball_mass
+        } else {
+            0.0
+        };
         for k in 1..=n {
             bodies.push(BodySpec {
                 name: names[k].clone(),
@@ -581,7 +634,7 @@ impl DrillPipeSpec {
                     half_length: p.pitch / 2.0,
                     inner_radius: 0.0,
                 },
-                mass: Some(p.link_mass),
+                mass: Some(p.link_mass + hinge_parts),
                 inertia: Some(p.link_inertia),
                 position: arr(&(0.5 * (hinges[k - 1] + hinges[k]))),
                 orientation: quat_array(&rotations[k]),
@@ -610,6 +663,7 @@ impl DrillPipeSpec {
             });
         }
 
+        let mut joints = vec![];
         let kb = &p.ball_keys;
         let cv = CvGeometry {
             pitch_radius: kb.pitch_radius,
@@ -621,12 +675,35 @@ impl DrillPipeSpec {
         let key_inertia = 0.4 * kb.ball_mass * kb.ball_radius * kb.ball_radius;
         for h in 0..=n {
             let (head, seat) = (&names[h], &names[h + 1]);
+            if p.hinge == HingeModel::IdealCv {
+                let head_half = if h == 0 { half_c } else { p.pitch / 2.0 };
+                let seat_half = if h == n { half_c } else { p.pitch / 2.0 };
+                let c = &p.ideal_cv;
+                joints.push(JointSpec::Cv {
+                    name: Some(format!("h{h:02}")),
+                    bodies: [head.clone(), seat.clone()],
+                    anchors: [[head_half, 0.0, 0.0], [-seat_half, 0.0, 0.0]],
+                    stiffness: c.stiffness,
+                    damping: c.damping,
+                    twist_stiffness: c.twist_stiffness,
+                    twist_damping: c.twist_damping,
+                    bend_limit_deg: c.bend_limit_deg,
+                    stop_stiffness: c.stop_stiffness,
+                });
+                continue;
+            }
             // Hinge centre in each body's frame: the head end is downhole (+x), the seat end uphole (−x).
             let head_half = if h == 0 { half_c } else { p.pitch / 2.0 };
             let seat_half = if h == n { half_c } else { p.pitch / 2.0 };
             let c_head = Vec3::new(head_half, 0.0, 0.0);
             let c_seat = Vec3::new(-seat_half, 0.0, 0.0);
             let beta = chain::bend_angle(&axes[h], &axes[h + 1], &z_b);
+            joints.push(JointSpec::BendStop {
+                name: Some(format!("h{h:02}.stop")),
+                bodies: [head.clone(), seat.clone()],
+                bend_limit_deg: kb.bend_limit_deg,
+                stop_stiffness: kb.stop_stiffness,
+            });
             let r_head = rotations[h];
             let r_cage = r_head * Quat::from_axis_angle(&Vec3::z_axis(), beta / 2.0);
             let cage = format!("h{h:02}.cage");
@@ -759,6 +836,7 @@ impl DrillPipeSpec {
                 magnitude: -self.load.resisting_moment,
                 ramp: self.load.ramp,
             }],
+            joints,
             origin: Some(Box::new(self.clone())),
         };
         scene.validate()?;

@@ -15,6 +15,7 @@
 //! [`NormalLaw`] and [`FrictionLaw`] are the closed sets the engine dispatches on.
 
 pub mod friction;
+pub mod joint;
 pub mod normal;
 
 pub use friction::{

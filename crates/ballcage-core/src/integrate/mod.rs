@@ -4,6 +4,11 @@
 //! manifold: the body-frame angular velocity drives a rotation vector ξ with
 //! `R = R₀·Exp(ξ)` (Runge–Kutta–Munthe-Kaas), so quaternions never leave the
 //! unit sphere by more than round-off.
+//!
+//! [`IntegratorKind::LinearlyImplicitEuler`] ([`implicit`]) also sees the
+//! velocity Jacobian of the forces, through [`Dynamics::forces_and_jacobian`].
+
+mod implicit;
 
 use crate::dynamics::{Accel, Dynamics, Mode};
 use crate::math::{Vec3, dexp_inv, exp_map};
@@ -19,6 +24,8 @@ pub struct Workspace {
     /// Rotation-vector rates of the stages [rad/s].
     kq: [Vec<Vec3>; 4],
     stage: State,
+    /// The linearly implicit step's pattern and factorization, built at its first step.
+    implicit: Option<Box<implicit::LinearlyImplicit>>,
 }
 
 impl Workspace {
@@ -36,7 +43,13 @@ impl Workspace {
             kx: [z.clone(), z.clone(), z.clone(), z.clone()],
             kq: [z.clone(), z.clone(), z.clone(), z],
             stage: state.clone(),
+            implicit: None,
         }
+    }
+
+    /// Sparse linear solves so far (the implicit integrators' cost unit).
+    pub fn linear_solves(&self) -> u64 {
+        self.implicit.as_ref().map_or(0, |w| w.solves)
     }
 }
 
@@ -52,6 +65,10 @@ pub fn step(
     match kind {
         IntegratorKind::SymplecticEuler => symplectic_euler(model, dynamics, ws, state, h),
         IntegratorKind::Rk4 => rk4(model, dynamics, ws, state, h),
+        IntegratorKind::LinearlyImplicitEuler => ws
+            .implicit
+            .get_or_insert_with(|| Box::new(implicit::LinearlyImplicit::new(model)))
+            .step(model, dynamics, state, h),
     }
 }
 
@@ -80,7 +97,9 @@ fn symplectic_euler(
 fn rk4(model: &Model, dynamics: &mut Dynamics, ws: &mut Workspace, state: &mut State, h: f64) {
     const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
     const W: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
-    let Workspace { acc, kx, kq, stage } = ws;
+    let Workspace {
+        acc, kx, kq, stage, ..
+    } = ws;
     for s in 0..4 {
         if s == 0 {
             stage.clone_from(state);

@@ -9,11 +9,13 @@
 
 mod body;
 mod contact;
+mod joint;
 mod load;
 mod overrides;
 
 pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
 pub use contact::{ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
+pub use joint::JointSpec;
 pub use load::LoadSpec;
 pub use overrides::apply_override;
 
@@ -34,6 +36,12 @@ pub enum IntegratorKind {
     /// Four force evaluations per step.
     #[default]
     Rk4,
+    /// Linearly implicit (Rosenbrock–Euler) step, implicit in the
+    /// velocity-dependent forces (contact damping, friction, joint dampers)
+    /// through their analytic velocity Jacobian, explicit in the elastic and
+    /// gyroscopic terms; positions and rotations as in symplectic Euler. One
+    /// force evaluation and one sparse LU solve per step.
+    LinearlyImplicitEuler,
 }
 
 impl IntegratorKind {
@@ -42,6 +50,7 @@ impl IntegratorKind {
         match self {
             Self::SymplecticEuler => "symplectic-euler",
             Self::Rk4 => "rk4",
+            Self::LinearlyImplicitEuler => "linearly-implicit-euler",
         }
     }
 }
@@ -192,6 +201,9 @@ pub struct Scene {
     /// Applied loads.
     #[serde(default)]
     pub loads: Vec<LoadSpec>,
+    /// Penalty joints.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointSpec>,
     /// The higher-level spec this scene was expanded from, if any; it is what
     /// [`Scene::to_toml`] writes back.
     #[serde(skip)]
@@ -257,8 +269,12 @@ impl Scene {
         Ok(scene)
     }
 
-    /// The scene as TOML, with every default written out.
+    /// The scene as TOML, with every default written out; a scene expanded
+    /// from a drill-pipe spec is written as that spec.
     pub fn to_toml(&self) -> String {
+        if let Some(origin) = &self.origin {
+            return origin.to_toml();
+        }
         // Serializing plain data with finite numbers cannot fail.
         toml::to_string_pretty(self)
             .unwrap_or_else(|e| format!("# scene could not be written: {e}\n"))
@@ -326,6 +342,9 @@ impl Scene {
         }
         for (i, l) in self.loads.iter().enumerate() {
             l.validate(&format!("loads[{i}]"), self)?;
+        }
+        for (i, j) in self.joints.iter().enumerate() {
+            j.validate(&format!("joints[{i}]"), self)?;
         }
         for (i, t) in self.record.tables.iter().enumerate() {
             if t.needs_drill_pipe() && self.origin.is_none() {

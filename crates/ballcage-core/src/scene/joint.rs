@@ -1,0 +1,113 @@
+//! Joint declarations.
+
+use serde::{Deserialize, Serialize};
+
+use super::{Scene, finite_vec, non_negative, positive};
+use crate::error::SceneError;
+
+/// A penalty joint. `type` selects the variant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum JointSpec {
+    /// Ideal constant-velocity joint: the hinge points coincide (spring-damper),
+    /// no relative twist about the bodies' x axes (torsional spring-damper),
+    /// bend limited by a stop.
+    Cv {
+        /// Name in messages.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        /// The two bodies `[a, b]`.
+        bodies: [String; 2],
+        /// Hinge point in each body's frame [m].
+        anchors: [[f64; 3]; 2],
+        /// Hinge-point spring [N/m].
+        stiffness: f64,
+        /// Hinge-point damper [N·s/m].
+        damping: f64,
+        /// Twist spring [N·m/rad].
+        twist_stiffness: f64,
+        /// Twist damper [N·m·s/rad].
+        twist_damping: f64,
+        /// Bend at which the stop engages [deg].
+        bend_limit_deg: f64,
+        /// Stop spring [N·m/rad].
+        stop_stiffness: f64,
+    },
+    /// Articulation stop only: a restoring torque `stop_stiffness·(β − limit)`
+    /// once the angle β between the bodies' x axes exceeds the limit.
+    BendStop {
+        /// Name in messages.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        name: Option<String>,
+        /// The two bodies `[a, b]`.
+        bodies: [String; 2],
+        /// Bend at which the stop engages [deg].
+        bend_limit_deg: f64,
+        /// Stop spring [N·m/rad].
+        stop_stiffness: f64,
+    },
+}
+
+impl JointSpec {
+    /// The two bodies `[a, b]`.
+    pub fn bodies(&self) -> &[String; 2] {
+        match self {
+            Self::Cv { bodies, .. } | Self::BendStop { bodies, .. } => bodies,
+        }
+    }
+
+    pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
+        let bodies = self.bodies();
+        let mut idx = [0usize; 2];
+        for (k, name) in bodies.iter().enumerate() {
+            idx[k] = scene.body_index(name).ok_or_else(|| {
+                SceneError::new(format!("{path}.bodies[{k}]"), name, "no body of that name")
+            })?;
+        }
+        if idx[0] == idx[1] {
+            return Err(SceneError::new(
+                format!("{path}.bodies"),
+                format!("{bodies:?}"),
+                "a joint needs two bodies",
+            ));
+        }
+        if !scene.bodies[idx[0]].is_integrated() && !scene.bodies[idx[1]].is_integrated() {
+            return Err(SceneError::new(
+                format!("{path}.bodies"),
+                format!("{bodies:?}"),
+                "neither body can move",
+            ));
+        }
+        match self {
+            Self::Cv {
+                anchors,
+                stiffness,
+                damping,
+                twist_stiffness,
+                twist_damping,
+                bend_limit_deg,
+                stop_stiffness,
+                ..
+            } => {
+                for (k, a) in anchors.iter().enumerate() {
+                    finite_vec(&format!("{path}.anchors[{k}]"), a)?;
+                }
+                positive(&format!("{path}.stiffness"), *stiffness)?;
+                non_negative(&format!("{path}.damping"), *damping)?;
+                positive(&format!("{path}.twist_stiffness"), *twist_stiffness)?;
+                non_negative(&format!("{path}.twist_damping"), *twist_damping)?;
+                positive(&format!("{path}.bend_limit_deg"), *bend_limit_deg)?;
+                positive(&format!("{path}.stop_stiffness"), *stop_stiffness)?;
+            }
+            Self::BendStop {
+                bend_limit_deg,
+                stop_stiffness,
+                ..
+            } => {
+                positive(&format!("{path}.bend_limit_deg"), *bend_limit_deg)?;
+                positive(&format!("{path}.stop_stiffness"), *stop_stiffness)?;
+            }
+        }
+        Ok(())
+    }
+}
