@@ -432,9 +432,9 @@ pub struct CouplingJacobian {
 /// A contact point p between a and b with arms r_i = p − x_i has the 3×3
 /// gradient G = ∂F_b/∂v_rel of the force on b with respect to the relative
 /// point velocity v_rel = (v_b + ω_b × r_b) − (v_a + ω_a × r_a); with the
-/// point-velocity map J_i = [I, −[r_i]×] and the wrench map
-/// W_i = [I; [r_i]×] it adds D_bb += W_b G J_b, D_ba −= W_b G J_a,
-/// D_ab −= W_a G J_b, D_aa += W_a G J_a.
+/// point-velocity map `J_i = [I, −[r_i]×]` and the wrench map
+/// `W_i = [I; [r_i]×]` it adds `D_bb += W_b G J_b`, `D_ba −= W_b G J_a`,
+/// `D_ab −= W_a G J_b`, `D_aa += W_a G J_a`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct VelocityJacobian {
     /// One entry per contact pair, then one per joint.
@@ -563,8 +563,8 @@ fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives) -> Mat3 {
 }
 
 /// W_i·G·J_j: the wrench on body i (force G·u at arm r_i) per unit twist of
-/// body j (u the velocity of j's point at arm r_j). With R = [r]×:
-/// [[G, −G·R_j], [R_i·G, −R_i·G·R_j]].
+/// body j (u the velocity of j's point at arm r_j). With `R = [r]×`:
+/// `[[G, −G·R_j], [R_i·G, −R_i·G·R_j]]`.
 fn wrench_twist_block(r_i: &Vec3, g: &Mat3, r_j: &Vec3) -> Mat6 {
     let ri = r_i.cross_matrix();
     let g_rj = g * r_j.cross_matrix();

@@ -154,6 +154,42 @@ pub struct Joint {
     pub params: crate::force::joint::CvJointParams,
 }
 
+impl Joint {
+    /// The joint's wrench on body b at `state`, with the arms `(r_a, r_b)` from
+    /// each body's centre of mass to its hinge point [m], world frame. Body a
+    /// gets the opposite force at its own hinge point and the opposite torque.
+    pub fn evaluate(&self, state: &State) -> (crate::force::joint::JointWrench, Vec3, Vec3) {
+        let (a, b) = (self.a, self.b);
+        let (ra, rb) = (state.rot[a] * self.anchor_a, state.rot[b] * self.anchor_b);
+        let (wa, wb) = (state.omega_world(a), state.omega_world(b));
+        let w = crate::force::joint::cv_joint_wrench(
+            &state.rot[a],
+            &state.rot[b],
+            &(state.pos[a] + ra),
+            &(state.pos[b] + rb),
+            &(state.vel[a] + wa.cross(&ra)),
+            &(state.vel[b] + wb.cross(&rb)),
+            &wa,
+            &wb,
+            &self.params,
+        );
+        (w, ra, rb)
+    }
+
+    /// Torque of the joint on body `i` about its centre of mass [N·m], world frame (zero if not attached).
+    pub fn torque_on(&self, state: &State, i: usize) -> Vec3 {
+        if i != self.a && i != self.b {
+            return Vec3::zeros();
+        }
+        let (w, ra, rb) = self.evaluate(state);
+        if i == self.b {
+            rb.cross(&w.force) + w.torque
+        } else {
+            -(ra.cross(&w.force) + w.torque)
+        }
+    }
+}
+
 /// What the recorder keeps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RecordPlan {

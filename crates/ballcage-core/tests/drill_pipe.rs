@@ -382,3 +382,63 @@ fn ideal_cv_and_ball_keys_agree_on_the_included_angles() {
         }
     }
 }
+
+/// Last value of column `name` of the recorded table `table`.
+fn last_value(
+    rec: &ballcage_core::record::Recording,
+    table: ballcage_core::scene::TableKind,
+    name: &str,
+) -> f64 {
+    let t = rec
+        .tables
+        .iter()
+        .find(|t| t.kind == table)
+        .expect("table recorded");
+    let col = ballcage_core::record::columns(table)
+        .iter()
+        .position(|c| c.name == name)
+        .expect("column");
+    match &t.data[col] {
+        ballcage_core::record::ColumnData::F64(v) => *v.last().expect("rows"),
+        other => panic!("{name} is not a float column: {other:?}"),
+    }
+}
+
+#[test]
+fn at_rest_the_drive_holds_exactly_the_resisting_moment() {
+    // Statics: with the drive held still, the torque the drive applies to the
+    // upper connector balances the 1.8 kN·m on the lower one, through either hinge model.
+    for (hinge, dt) in [("ideal-cv", "1e-5"), ("ball-keys", "2e-7")] {
+        let o: Vec<String> = [
+            format!("pipe.hinge=\"{hinge}\""),
+            "pipe.joints=1".into(),
+            "borehole.curvature_radius=1000".into(),
+            "drive.speed_rpm=0".into(),
+            "load.ramp=0.04".into(),
+            "world.gravity=0".into(),
+            "simulation.duration=0.12".into(),
+            format!("simulation.dt={dt}"),
+            "simulation.output_interval=0.01".into(),
+            "record.tables=[\"drive\"]".into(),
+        ]
+        .to_vec();
+        let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+        let mut sim = Simulation::new(&scene).unwrap();
+        sim.run().unwrap();
+        let rec = sim.finish();
+        let input = last_value(&rec, ballcage_core::scene::TableKind::Drive, "input_torque");
+        let output = last_value(
+            &rec,
+            ballcage_core::scene::TableKind::Drive,
+            "output_torque",
+        );
+        assert!(
+            (output - 1800.0).abs() < 1e-9,
+            "{hinge}: output torque {output}"
+        );
+        assert!(
+            ((input - 1800.0) / 1800.0).abs() < 0.01,
+            "{hinge}: input torque {input} N·m"
+        );
+    }
+}

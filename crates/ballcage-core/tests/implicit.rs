@@ -168,17 +168,13 @@ const JACOBIAN_SCENE: &str = r#"
 
 #[test]
 fn velocity_jacobian_matches_finite_differences() {
-    let sim = common::sim(JACOBIAN_SCENE);
-    // Every pair is in contact with positive normal force and smooth slip.
-    let mut sim2 = common::sim(JACOBIAN_SCENE);
-    for k in 0..sim2.model().pairs.len() {
-        let points = sim2.pair_contacts(k);
+    let mut sim = common::sim(JACOBIAN_SCENE);
+    // Every pair is in contact with positive normal force and smooth slip
+    // (block: 4 vertices sliding at 0.25–0.41 m/s; ball: 0.083 m/s; key: 0.080 m/s).
+    for k in 0..sim.model().pairs.len() {
+        let points = sim.pair_contacts(k);
         assert!(!points.is_empty(), "pair {k} is not in contact");
         for p in &points {
-            eprintln!(
-                "pair {k}: δ = {:.3e} F_n = {:.4e} slip = {:.4e} rate = {:.3e}",
-                p.point.depth, p.normal_force, p.slip_speed, p.depth_rate
-            );
             assert!(p.normal_force > 0.0, "pair {k}: {p:?}");
             assert!(p.slip_speed > 1e-3, "pair {k}: {p:?}");
         }

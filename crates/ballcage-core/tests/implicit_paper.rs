@@ -46,6 +46,7 @@ fn paper_scene_matches_the_fine_explicit_reference() {
         // largest error of a pair against the reference.
         for group in ["/tube", ".cage/", ".key", ".stop"] {
             let mut sum = (0.0, 0.0);
+            let mut tangential = (0.0, 0.0);
             let mut worst: (f64, String) = (0.0, String::new());
             let mut peak: f64 = 0.0;
             for (k, pair) in reference.model().pairs.iter().enumerate() {
@@ -54,6 +55,8 @@ fn paper_scene_matches_the_fine_explicit_reference() {
                 }
                 sum.0 += f_ref[k].0;
                 sum.1 += f[k].0;
+                tangential.0 += f_ref[k].1;
+                tangential.1 += f[k].1;
                 peak = peak.max(f_ref[k].0);
                 let err = (f[k].0 - f_ref[k].0).abs();
                 if err > worst.0 {
@@ -61,8 +64,9 @@ fn paper_scene_matches_the_fine_explicit_reference() {
                 }
             }
             eprintln!(
-                "  dt = {dt:e} {group:>6}: ΣF_n {:.1} N (reference {:.1} N), peak {peak:.1} N, worst pair error {:.1} N at {}",
-                sum.1, sum.0, worst.0, worst.1
+                "  dt = {dt:e} {group:>6}: ΣF_n {:.1} N (reference {:.1} N), ΣF_t {:.2} N \
+                 (reference {:.2} N), peak F_n {peak:.1} N, worst pair F_n error {:.2} N at {}",
+                sum.1, sum.0, tangential.1, tangential.0, worst.0, worst.1
             );
         }
         // The links' poses.

@@ -324,8 +324,9 @@ fn drive(
     };
     let (input_speed, input_torque) = match model.bodies[upper].motion {
         Motion::KinematicSpin(p) => {
-            // The drive supplies what the contacts take plus what spins up the connector.
-            let contact = contact_torque(model, s, evals, upper).dot(&p.axis);
+            // The drive supplies what the contacts and joints take plus what spins up the connector.
+            let joints: Vec3 = model.joints.iter().map(|j| j.torque_on(s, upper)).sum();
+            let contact = (contact_torque(model, s, evals, upper) + joints).dot(&p.axis);
             let inertia = p.axis.dot(
                 &(s.rot[upper]
                     * model.bodies[upper]
