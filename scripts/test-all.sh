@@ -11,7 +11,6 @@ cargo clippy --workspace --all-targets -- -D warnings
 echo "== cargo test"
 cargo test --workspace
 echo "== pip install .[test] (release build of the wheel)"
-python3 -m pip install --quiet --upgrade pip
 python3 -m pip install --quiet ".[test]"
 echo "== pytest"
 # The package source lives in python/, so the root is not on the import path

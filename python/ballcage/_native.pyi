@@ -77,7 +77,7 @@ class Scene:
         """Interval between recorded frames [s]."""
 
     @property
-    def integrator(self) -> Literal["rk4", "symplectic-euler"]: ...
+    def integrator(self) -> Literal["rk4", "symplectic-euler", "linearly-implicit-euler"]: ...
     @property
     def table_names(self) -> list[str]:
         """Tables the scene records, e.g. ``["bodies", "contacts"]``."""

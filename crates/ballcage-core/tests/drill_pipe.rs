@@ -180,6 +180,7 @@ fn quasi_static_hinges(extra: &[&str]) -> (Vec<(f64, f64)>, f64) {
         "world.gravity=0",
         "simulation.duration=0.12",
         "simulation.dt=2e-7",
+        "simulation.integrator=\"symplectic-euler\"",
         "simulation.output_interval=0.01",
         "record.tables=[]",
     ]
@@ -288,6 +289,7 @@ fn a_ball_key_hinge_passes_spin_at_constant_velocity() {
         "world.gravity=0",
         "simulation.duration=0.5",
         "simulation.dt=1e-6",
+        "simulation.integrator=\"symplectic-euler\"",
         "simulation.output_interval=0.001",
         "record.tables=[]",
     ]
@@ -355,6 +357,7 @@ fn ideal_cv_and_ball_keys_agree_on_the_included_angles() {
             format!("pipe.hinge=\"{hinge}\""),
             "simulation.duration=0.015".into(),
             format!("simulation.dt={dt}"),
+            "simulation.integrator=\"symplectic-euler\"".into(),
             "simulation.output_interval=0.005".into(),
             "record.tables=[]".into(),
         ]
@@ -418,6 +421,7 @@ fn at_rest_the_drive_holds_exactly_the_resisting_moment() {
             "world.gravity=0".into(),
             "simulation.duration=0.12".into(),
             format!("simulation.dt={dt}"),
+            "simulation.integrator=\"symplectic-euler\"".into(),
             "simulation.output_interval=0.01".into(),
             "record.tables=[\"drive\"]".into(),
         ]

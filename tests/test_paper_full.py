@@ -1,0 +1,105 @@
+"""The paper's whole 1.8 s ball-key scene (about 2.5 min on 2 cores): the chain
+stays in the tube, every key stays in its grooves and window, nothing is
+non-finite, and the drive balances the resisting moment on average.
+
+Limits are geometric (physics.md §3, §4), not numbers of an earlier run:
+- a link centre may move off the tube centreline by the radial clearance,
+  (116 − 86)/2 = 15 mm, plus its contact penetration (< 1 mm under the
+  Adams law at the forces involved);
+- a key centre stays at ≈ PCR = 31.5 mm from its cage's axis: the bisector
+  geometry moves it by ±c·sin(β/2) (0.52 mm at the 15° stop), flank clearance
+  and penetration add up to 0.6 mm at 33.5 kN (physics.md §5), the cage
+  clearances 0.02 mm: 1.5 mm bounds all of that, while a key out of its
+  Gothic-arch groove would have to climb its ~2 mm depth;
+- a key stays inside its 15.03 mm cage window: |axial offset| ≤ 7.515 mm − r_b
+  + penetration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pytest
+
+import ballcage
+
+PCR = 0.0315
+CLEARANCE = (0.116 - 0.086) / 2
+
+
+@pytest.fixture(scope="module")
+def paper_run() -> ballcage.Run:
+    names = (
+        ["upper", "lower"]
+        + [f"link{k:02d}" for k in range(1, 13)]
+        + [f"h{h:02d}.cage" for h in range(13)]
+        + [f"h{h:02d}.key{j}" for h in range(13) for j in range(6)]
+    )
+    overrides = [
+        'record.tables=["bodies", "links", "keys", "drive", "summary"]',
+        "record.bodies=[" + ", ".join(f'"{n}"' for n in names) + "]",
+    ]
+    return ballcage.simulate({"kind": "drill-pipe"}, overrides=overrides, progress=False)
+
+
+def _rows(run: ballcage.Run, body: str) -> dict[str, np.ndarray]:
+    """The `bodies` columns of one body, frame by frame."""
+    rows = run.bodies.filter(pc.equal(run.bodies["body"].cast(pa.string()), body))
+    assert rows.num_rows > 0, body
+    return {c: rows[c].to_numpy() for c in rows.column_names if c.startswith(("pos_", "quat_"))}
+
+
+def _positions(run: ballcage.Run, body: str) -> np.ndarray:
+    r = _rows(run, body)
+    return np.stack([r["pos_x"], r["pos_y"], r["pos_z"]], axis=1)
+
+
+def test_the_run_completes_without_non_finite_values(paper_run):
+    assert paper_run.metadata["ballcage.complete"] == "true"
+    assert paper_run.metadata["ballcage.integrator"] == "linearly-implicit-euler"
+    for name, table in paper_run.tables.items():
+        for column in table.column_names:
+            values = table[column]
+            if values.type in ("double", "float"):
+                assert np.isfinite(values.to_numpy()).all(), f"{name}.{column} has non-finite values"
+
+
+def test_no_link_leaves_the_tube(paper_run):
+    links = paper_run.tables["links"]
+    t = links["t"].to_numpy()
+    offset = links["radial_offset"].to_numpy()
+    link = links["link"].to_numpy()
+    # Link 12 reaches past the arc's end, where the centreline continues straight.
+    assert offset.max() < CLEARANCE + 1e-3, f"a link centre is {offset.max() * 1e3:.2f} mm off the centreline"
+    assert set(np.unique(link)) == set(range(1, 13))
+    assert t.max() == pytest.approx(1.8)
+
+
+def test_every_key_stays_in_its_grooves_and_window(paper_run):
+    worst_radial = 0.0
+    worst_axial = 0.0
+    for h in range(13):
+        cage = _positions(paper_run, f"h{h:02d}.cage")
+        r = _rows(paper_run, f"h{h:02d}.cage")
+        w, x, y, z = r["quat_w"], r["quat_x"], r["quat_y"], r["quat_z"]
+        # Cage axis = body x axis in the world frame.
+        axis = np.stack([1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)], axis=1)
+        for j in range(6):
+            d = _positions(paper_run, f"h{h:02d}.key{j}") - cage
+            axial = np.einsum("ij,ij->i", d, axis)
+            radial = np.linalg.norm(d - axial[:, None] * axis, axis=1)
+            worst_radial = max(worst_radial, float(np.abs(radial - PCR).max()))
+            worst_axial = max(worst_axial, float(np.abs(axial).max()))
+    assert worst_radial < 1.5e-3, f"a key moved {worst_radial * 1e3:.3f} mm off the pitch circle"
+    assert worst_axial < 0.01503 / 2 - 0.0075 + 1e-3, f"a key is {worst_axial * 1e3:.3f} mm off its window centre"
+
+
+def test_the_drive_transmits_the_resisting_moment(paper_run):
+    drive = paper_run.tables["drive"]
+    late = pc.greater(drive["t"], 1.2)
+    out_speed = drive["output_speed"].filter(late).to_numpy()
+    in_torque = drive["input_torque"].filter(late).to_numpy()
+    # Steady spin at the drive speed, and the input torque covers the 1.8 kN·m plus losses.
+    assert out_speed.mean() == pytest.approx(100 * 2 * np.pi / 60, rel=0.01)
+    assert 1800.0 < in_torque.mean() < 1800.0 / 0.8
