@@ -19,8 +19,6 @@ fn main() {
     ];
     let mut all = overrides.clone();
     all.extend(args.iter().skip(4).cloned());
-    let scene = Scene::from_table(toml::Table::new(), &[]).err();
-    let _ = scene;
     let scene =
         Scene::from_toml_str("kind = \"drill-pipe\"\n", &all).unwrap_or_else(|e| panic!("{e}"));
     println!(

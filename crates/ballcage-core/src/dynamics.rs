@@ -9,7 +9,7 @@
 //!    for `spin` bodies.
 
 use crate::force::friction_force;
-use crate::force::joint::cv_joint_wrench;
+use crate::force::joint::twist_axis;
 use crate::geometry::ContactPoint;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
@@ -163,20 +163,7 @@ impl Dynamics {
         // 2. joints
         for (n, j) in model.joints.iter().enumerate() {
             let (a, b) = (j.a, j.b);
-            let (ra, rb) = (state.rot[a] * j.anchor_a, state.rot[b] * j.anchor_b);
-            let (pa, pb) = (state.pos[a] + ra, state.pos[b] + rb);
-            let (wa, wb) = (state.omega_world(a), state.omega_world(b));
-            let w = cv_joint_wrench(
-                &state.rot[a],
-                &state.rot[b],
-                &pa,
-                &pb,
-                &(state.vel[a] + wa.cross(&ra)),
-                &(state.vel[b] + wb.cross(&rb)),
-                &wa,
-                &wb,
-                &j.params,
-            );
+            let (w, ra, rb) = j.evaluate(state);
             self.force[b] += w.force;
             self.torque[b] += rb.cross(&w.force) + w.torque;
             self.force[a] -= w.force;
@@ -524,15 +511,14 @@ impl VelocityJacobian {
 
     /// The joint's dampers: −c·(v_b(p_b) − v_a(p_a)) at the hinge points
     /// (arms `ra`, `rb`) and −c_t·(ê·(ω_b − ω_a))·ê on b about the mean x
-    /// axis ê (the axis of [`cv_joint_wrench`]).
+    /// axis ê ([`twist_axis`]).
     fn add_joint(&mut self, k: usize, j: &Joint, state: &State, ra: &Vec3, rb: &Vec3) {
         let p = &j.params;
         if p.damping != 0.0 {
             self.add_gradient(k, &(-p.damping * Mat3::identity()), ra, rb);
         }
         if p.twist_damping != 0.0 {
-            let (ea, eb) = (state.rot[j.a] * Vec3::x(), state.rot[j.b] * Vec3::x());
-            let axis = (ea + eb).try_normalize(1e-12).unwrap_or(ea);
+            let axis = twist_axis(&state.rot[j.a], &state.rot[j.b]);
             let t = p.twist_damping * axis * axis.transpose();
             let c = &mut self.couplings[k];
             c.active = true;

@@ -48,6 +48,13 @@ pub fn twist_angle(qa: &Quat, qb: &Quat) -> f64 {
     (t + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
 }
 
+/// Axis of the twist spring and damper: the bisector of the two body x axes
+/// (world frame), or a's axis when they are opposite.
+pub fn twist_axis(qa: &Quat, qb: &Quat) -> Vec3 {
+    let (ea, eb) = (qa * Vec3::x(), qb * Vec3::x());
+    (ea + eb).try_normalize(1e-12).unwrap_or(ea)
+}
+
 /// Wrench of a CV joint. `pa`, `pb`: hinge points [m]; `va`, `vb`: their
 /// velocities [m/s]; `wa`, `wb`: angular velocities [rad/s]; all world frame.
 #[allow(clippy::too_many_arguments)]
@@ -64,7 +71,7 @@ pub fn cv_joint_wrench(
 ) -> JointWrench {
     let force = -p.stiffness * (pb - pa) - p.damping * (vb - va);
     let (ea, eb) = (qa * Vec3::x(), qb * Vec3::x());
-    let axis = (ea + eb).try_normalize(1e-12).unwrap_or(ea);
+    let axis = twist_axis(qa, qb);
     let twist = twist_angle(qa, qb);
     let mut torque = -(p.twist_stiffness * twist + p.twist_damping * (wb - wa).dot(&axis)) * axis;
     let cross = ea.cross(&eb);

@@ -81,28 +81,6 @@ pub struct ImpactParams {
     pub depth_max: f64,
 }
 
-impl ImpactParams {
-    /// Converts parameters given in the paper's field units to SI.
-    ///
-    /// * `stiffness_n_per_mm_n`: K \[N/mmⁿ\] → K·1000ⁿ \[N/mⁿ\]
-    /// * `exponent`: n \[-\] (unchanged)
-    /// * `damping_ns_per_mm`: c_max \[N·s/mm\] → c_max·1000 \[N·s/m\]
-    /// * `depth_max_mm`: d_max \[mm\] → d_max/1000 \[m\]
-    pub fn from_field_units(
-        stiffness_n_per_mm_n: f64,
-        exponent: f64,
-        damping_ns_per_mm: f64,
-        depth_max_mm: f64,
-    ) -> Self {
-        Self {
-            stiffness: stiffness_n_per_mm_n * 1000f64.powf(exponent),
-            exponent,
-            damping: damping_ns_per_mm * 1000.0,
-            depth_max: depth_max_mm / 1000.0,
-        }
-    }
-}
-
 /// Parameters of the restitution-based dissipative laws
 /// (Lankarani–Nikravesh, Hunt–Crossley, Flores).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -314,10 +292,16 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
-    /// Paper parameters: K = 1e5 N/mm^2.2, n = 2.2, c_max = 10 N·s/mm,
-    /// d_max = 0.1 mm.
+    /// Paper parameters K = 1e5 N/mm^2.2, n = 2.2, c_max = 10 N·s/mm,
+    /// d_max = 0.1 mm, in SI (the scene converts field units; see
+    /// tests/resting_contact.rs::paper_field_units_convert_once_to_si).
     fn paper_impact() -> ImpactParams {
-        ImpactParams::from_field_units(1e5, 2.2, 10.0, 0.1)
+        ImpactParams {
+            stiffness: 1e5 * 1000f64.powf(2.2),
+            exponent: 2.2,
+            damping: 1e4,
+            depth_max: 1e-4,
+        }
     }
 
     fn dissipative(restitution: f64) -> DissipativeParams {
