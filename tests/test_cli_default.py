@@ -69,3 +69,35 @@ def test_schema_lists_every_table():
     assert set(headers) >= {"bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"}
     links = _cli("schema", "links")
     assert links.returncode == 0 and "radial_offset" in links.stdout and "[m]" in links.stdout
+
+
+def test_drill_pipe_builder_equals_the_toml_section_and_the_dotted_keys():
+    built = (
+        ballcage.DrillPipeBuilder()
+        .borehole(curvature_radius=2.5)
+        .pipe(joints=4, hinge="ideal-cv")
+        .drive(speed_rpm=60)
+        .load(resisting_moment=900.0)
+        .simulation(duration=0.01)
+    )
+    toml_text = (
+        'kind = "drill-pipe"\n[borehole]\ncurvature_radius = 2.5\n[pipe]\njoints = 4\nhinge = "ideal-cv"\n'
+        "[drive]\nspeed_rpm = 60\n[load]\nresisting_moment = 900.0\n[simulation]\nduration = 0.01\n"
+    )
+    dotted = [
+        "borehole.curvature_radius=2.5",
+        'pipe.hinge="ideal-cv"',
+        "pipe.joints=4",
+        "drive.speed_rpm=60",
+        "load.resisting_moment=900.0",
+        "simulation.duration=0.01",
+    ]
+    a = ballcage.load_scene(built).to_toml()
+    assert a == _native.Scene.from_toml(toml_text).to_toml()
+    assert a == default_scene(dotted).to_toml()
+    resolved = tomllib.loads(a)
+    assert resolved["pipe"]["joints"] == 4 and resolved["drive"]["speed_rpm"] == 60
+    run = ballcage.simulate(built, progress=False)
+    # Four links and the two connectors are recorded; no keys or cages exist in the ideal-CV model.
+    names = set(run.bodies["body"].cast("string").to_pylist())
+    assert names == {"upper", "lower", "link01", "link02", "link03", "link04"}

@@ -175,7 +175,7 @@ def test_debug_build_warns_on_import():
 
 def test_public_api_is_curated():
     assert set(ballcage.__all__) == {
-        "Run", "Scene", "SceneBuilder", "SceneError", "Simulation", "SimulationError",
+        "DrillPipeBuilder", "Run", "Scene", "SceneBuilder", "SceneError", "Simulation", "SimulationError",
         "__version__", "load_scene", "simulate", "table_schema",
     }
     assert issubclass(ballcage.SceneError, ValueError)

@@ -26,11 +26,12 @@ from typing import Any
 from ballcage import _native
 from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
 from ballcage.run import Run, simulate
-from ballcage.scene import SceneBuilder, load_scene
+from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
 
 __version__: str = _native.__version__
 
 __all__ = [
+    "DrillPipeBuilder",
     "Run",
     "Scene",
     "SceneBuilder",

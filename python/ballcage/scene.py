@@ -4,7 +4,7 @@ There is one way in for each kind of source:
 
 - a path (``str`` or ``os.PathLike``) to a TOML file,
 - a dict with the structure of the TOML file,
-- a `SceneBuilder`, which emits such a dict,
+- a `SceneBuilder` or a `DrillPipeBuilder`, which emit such a dict,
 - an already validated `ballcage.Scene`.
 
 `default_scene` is the embedded paper scene (Zhu et al. 2023's drill pipe):
@@ -26,7 +26,7 @@ from typing import Any, Self, TypeAlias
 
 from ballcage import _native
 
-__all__ = ["SceneBuilder", "SceneSource", "default_scene", "default_scene_toml", "load_scene"]
+__all__ = ["DrillPipeBuilder", "SceneBuilder", "SceneSource", "default_scene", "default_scene_toml", "load_scene"]
 
 
 class SceneBuilder:
@@ -116,7 +116,77 @@ class SceneBuilder:
         return f"SceneBuilder({self._scene.get('name', '')!r}, bodies={len(self._scene['bodies'])})"
 
 
-SceneSource: TypeAlias = "str | os.PathLike[str] | Mapping[str, Any] | SceneBuilder | _native.Scene"
+class DrillPipeBuilder:
+    """Builds a drill-pipe scene dict (``kind = "drill-pipe"``) section by section.
+
+    Every section and field left out takes the paper's value, so only what
+    differs is written::
+
+        scene = (
+            DrillPipeBuilder()
+            .borehole(curvature_radius=2.5)          # m
+            .pipe(joints=12, hinge="ideal-cv")
+            .drive(speed_rpm=60)                      # rpm
+            .load(resisting_moment=1800.0)            # N·m
+            .simulation(duration=0.5)                 # s
+        )
+        run = ballcage.simulate(scene)
+
+    Each method takes the fields of its TOML section (`ballcage scene show`
+    prints them all with units); nested tables such as ``pipe.ball_keys`` are
+    dicts. Nothing is checked here: `load_scene` validates in Rust.
+    """
+
+    def __init__(self, name: str | None = None) -> None:
+        self._scene: dict[str, Any] = {"kind": "drill-pipe"}
+        if name is not None:
+            self._scene["name"] = name
+
+    def _section(self, section: str, fields: dict[str, Any]) -> Self:
+        self._scene.setdefault(section, {}).update(copy.deepcopy(fields))
+        return self
+
+    def simulation(self, **fields: Any) -> Self:
+        """`duration`, `dt`, `output_interval` [s], `integrator`."""
+        return self._section("simulation", fields)
+
+    def world(self, **fields: Any) -> Self:
+        """`gravity` [m/s², along −z]."""
+        return self._section("world", fields)
+
+    def borehole(self, **fields: Any) -> Self:
+        """`curvature_radius` [m], `build_angle_deg` [deg], `inner_diameter` [m]."""
+        return self._section("borehole", fields)
+
+    def pipe(self, **fields: Any) -> Self:
+        """`joints`, `hinge` ("ball-keys" or "ideal-cv"), `pitch` [m], sizes, masses, `ball_keys`, `ideal_cv`."""
+        return self._section("pipe", fields)
+
+    def drive(self, **fields: Any) -> Self:
+        """`speed_rpm` [rpm], `ramp` [s]."""
+        return self._section("drive", fields)
+
+    def load(self, **fields: Any) -> Self:
+        """`resisting_moment` [N·m], `ramp` [s]."""
+        return self._section("load", fields)
+
+    def materials(self, **fields: Any) -> Self:
+        """`tube` and `internal`, each ``{"normal": {...}, "friction": {...}}``."""
+        return self._section("materials", fields)
+
+    def record(self, **fields: Any) -> Self:
+        """`tables`, `bodies`, `contacts`, `summary_window`."""
+        return self._section("record", fields)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The scene dict (a deep copy)."""
+        return copy.deepcopy(self._scene)
+
+    def __repr__(self) -> str:
+        return f"DrillPipeBuilder({self._scene!r})"
+
+
+SceneSource: TypeAlias = "str | os.PathLike[str] | Mapping[str, Any] | SceneBuilder | DrillPipeBuilder | _native.Scene"
 
 
 def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Scene:
@@ -135,7 +205,7 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
     patches = list(overrides)
     if isinstance(source, _native.Scene):
         return _native.Scene.from_toml(source.to_toml(), patches) if patches else source
-    if isinstance(source, SceneBuilder):
+    if isinstance(source, (SceneBuilder, DrillPipeBuilder)):
         return _native.Scene.from_dict(source.to_dict(), patches)
     if isinstance(source, Mapping):
         return _native.Scene.from_dict(_plain(source), patches)
