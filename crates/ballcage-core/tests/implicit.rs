@@ -375,33 +375,8 @@ fn stiff_damped_contact_settles_where_symplectic_euler_diverges() {
 }
 
 fn incline(integrator: &str, alpha_deg: f64, dt: f64, duration: f64) -> Simulation {
-    let a = alpha_deg.to_radians();
-    let (gx, gz) = (9.8 * a.cos(), -9.8 * a.sin());
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = {duration}
-        dt = {dt}
-        output_interval = {dt}
-        integrator = "{integrator}"
-        [world]
-        gravity = [{gx}, 0.0, {gz}]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "incline"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "block"
-        shape = {{ type = "cuboid", half_extents = [0.05, 0.05, 0.02] }}
-        mass = 1.0
-        position = [0.0, 0.0, 0.02]
-        [[contacts]]
-        bodies = ["incline", "block"]
-        normal = {{ law = "linear", stiffness = 1e6, damping = 1000.0 }}
-        friction = {{ law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 0.1, v_dynamic = 1.0 }}
-        "#
+    common::sim(&common::incline_scene(
+        alpha_deg, integrator, dt, dt, duration,
     ))
 }
 

@@ -9,35 +9,10 @@
 mod common;
 
 fn block_on_incline(alpha_deg: f64, duration: f64) -> common::Probe {
-    let a = alpha_deg.to_radians();
-    let (gx, gz) = (9.8 * a.cos(), -9.8 * a.sin());
-    let toml = format!(
-        r#"
-        [simulation]
-        duration = {duration}
-        dt = 2e-5
-        output_interval = 1e-2
-        integrator = "rk4"
-        [world]
-        gravity = [{gx}, 0.0, {gz}]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "incline"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "block"
-        shape = {{ type = "cuboid", half_extents = [0.05, 0.05, 0.02] }}
-        mass = 1.0
-        position = [0.0, 0.0, 0.02]
-        [[contacts]]
-        bodies = ["incline", "block"]
-        normal = {{ law = "linear", stiffness = 1e6, damping = 1000.0 }}
-        friction = {{ law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 0.1, v_dynamic = 1.0 }}
-        "#
-    );
-    common::Probe::run(&toml, "block")
+    common::Probe::run(
+        &common::incline_scene(alpha_deg, "rk4", 2e-5, 1e-2, duration),
+        "block",
+    )
 }
 
 #[test]

@@ -53,3 +53,43 @@ impl Probe {
             .expect("samples")
     }
 }
+
+/// The incline of physics.md §7.7: a 1 kg block on a horizontal plane with
+/// gravity tilted to α from vertical, g = 9.8·(cos α, 0, −sin α), a linear
+/// normal law and the Adams friction law (μs 0.3, μd 0.1, v_s 0.1, v_d 1 m/s).
+pub fn incline_scene(
+    alpha_deg: f64,
+    integrator: &str,
+    dt: f64,
+    output_interval: f64,
+    duration: f64,
+) -> String {
+    let a = alpha_deg.to_radians();
+    let (gx, gz) = (9.8 * a.cos(), -9.8 * a.sin());
+    format!(
+        r#"
+        [simulation]
+        duration = {duration}
+        dt = {dt}
+        output_interval = {output_interval}
+        integrator = "{integrator}"
+        [world]
+        gravity = [{gx}, 0.0, {gz}]
+        [record]
+        tables = []
+        [[bodies]]
+        name = "incline"
+        motion = "fixed"
+        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
+        [[bodies]]
+        name = "block"
+        shape = {{ type = "cuboid", half_extents = [0.05, 0.05, 0.02] }}
+        mass = 1.0
+        position = [0.0, 0.0, 0.02]
+        [[contacts]]
+        bodies = ["incline", "block"]
+        normal = {{ law = "linear", stiffness = 1e6, damping = 1000.0 }}
+        friction = {{ law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 0.1, v_dynamic = 1.0 }}
+        "#
+    )
+}
