@@ -12,6 +12,7 @@ __all__ = [
     "__version__",
     "BUILD_PROFILE",
     "TABLE_NAMES",
+    "INTEGRATORS",
     "SceneError",
     "SimulationError",
     "Scene",
@@ -27,6 +28,8 @@ __version__: str
 BUILD_PROFILE: Literal["release", "debug"]
 #: Every output table name, in the order `ballcage schema` prints them.
 TABLE_NAMES: list[str]
+#: Every integrator name `simulation.integrator` accepts, explicit ones first.
+INTEGRATORS: list[str]
 
 class SceneError(ValueError):
     """A scene that cannot be read or validated.

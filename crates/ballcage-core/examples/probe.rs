@@ -47,4 +47,12 @@ fn main() {
             break;
         }
     }
+    let st = sim.solver_stats();
+    println!(
+        "force evaluations {} factorizations {} solves {} newton iterations {}",
+        sim.force_evaluations(),
+        st.factorizations,
+        st.solves,
+        st.newton_iterations
+    );
 }

@@ -73,6 +73,22 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
             )
         })?;
         let (geometry, swapped) = c.resolve_geometry(&path, scene)?;
+        let (first, second) = if swapped { (b, a) } else { (a, b) };
+        let divergence = &scene.simulation.divergence;
+        let depth_limit = divergence.max_penetration.unwrap_or_else(|| {
+            divergence.penetration_fraction
+                * geometry.contact_radius(&bodies[first].shape, &bodies[second].shape)
+        });
+        // Only free bodies translate; the others count as infinitely heavy.
+        let inverse_mass = |i: usize| {
+            let body: &Body = &bodies[i];
+            if body.motion == Motion::Dynamic {
+                1.0 / body.mass
+            } else {
+                0.0
+            }
+        };
+        let reduced_mass = 1.0 / (inverse_mass(a) + inverse_mass(b));
         pairs.push(ContactPair {
             name: c.pair_name(),
             a,
@@ -85,6 +101,8 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
                 .as_ref()
                 .map(|f| f.to_law(&format!("{path}.friction")))
                 .transpose()?,
+            depth_limit,
+            reduced_mass,
         });
     }
 
@@ -221,6 +239,8 @@ pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
         gravity: Vec3::from(scene.world.gravity),
         integrator: scene.simulation.integrator,
         dt: scene.simulation.dt,
+        newton: scene.simulation.newton.clone(),
+        energy_growth: scene.simulation.divergence.energy_growth,
         steps_per_output: scene.steps_per_output(),
         total_steps: scene.total_steps(),
         record,

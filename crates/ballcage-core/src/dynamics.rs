@@ -86,6 +86,70 @@ pub struct Dynamics {
     latched: Vec<Vec<Option<f64>>>,
     /// Number of force evaluations so far.
     pub evaluations: u64,
+    /// Deepest penetration and stiffest contact since the last reset.
+    pub watch: ContactWatch,
+}
+
+/// What the contact points evaluated since the last
+/// [`ContactWatch::reset`] say about divergence and the stable step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactWatch {
+    /// The deepest penetration relative to its pair's limit:
+    /// (pair, depth [m], depth / limit).
+    pub deepest: Option<(usize, f64, f64)>,
+    /// The smallest stable step of symplectic Euler over the points, from
+    /// the linearized contact (stiffness k = ∂F/∂δ, damping c = ∂F/∂δ̇ plus
+    /// the friction slope, the pair's reduced mass m):
+    /// h = 2 / (ζω + √(ζ²ω² + ω²)) with ω² = k/m, ζω = c/2m; with its pair.
+    pub explicit_step: (f64, usize),
+    /// The smallest 2/ω over the points (the elastic limit alone, which
+    /// binds an integrator implicit in the damping only); with its pair.
+    pub elastic_step: (f64, usize),
+    /// The shortest contact period 2π/ω over the points [s]; with its pair.
+    pub period: (f64, usize),
+}
+
+impl Default for ContactWatch {
+    fn default() -> Self {
+        Self {
+            deepest: None,
+            explicit_step: (f64::INFINITY, usize::MAX),
+            elastic_step: (f64::INFINITY, usize::MAX),
+            period: (f64::INFINITY, usize::MAX),
+        }
+    }
+}
+
+impl ContactWatch {
+    /// Forgets everything seen.
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+
+    fn see(&mut self, k: usize, pair: &ContactPair, e: &ContactEval, d: &PointDerivatives) {
+        let ratio = e.point.depth / pair.depth_limit;
+        if ratio > self.deepest.map_or(0.0, |(_, _, r)| r) {
+            self.deepest = Some((k, e.point.depth, ratio));
+        }
+        let m = pair.reduced_mass;
+        if e.normal_force <= 0.0 || !m.is_finite() {
+            return;
+        }
+        let omega = (d.d_depth.max(0.0) / m).sqrt();
+        let half_rate = (d.d_rate.max(0.0) + d.friction.norm()) / (2.0 * m);
+        let explicit = 2.0 / (half_rate + (half_rate * half_rate + omega * omega).sqrt());
+        if explicit < self.explicit_step.0 {
+            self.explicit_step = (explicit, k);
+        }
+        if omega > 0.0 {
+            if 2.0 / omega < self.elastic_step.0 {
+                self.elastic_step = (2.0 / omega, k);
+            }
+            if std::f64::consts::TAU / omega < self.period.0 {
+                self.period = (std::f64::consts::TAU / omega, k);
+            }
+        }
+    }
 }
 
 impl Dynamics {
@@ -108,6 +172,7 @@ impl Dynamics {
                 })
                 .collect(),
             evaluations: 0,
+            watch: ContactWatch::default(),
         }
     }
 
@@ -152,9 +217,14 @@ impl Dynamics {
             jac.clear();
         }
         self.evaluations += 1;
-        // 1. applied loads
-        for &i in &model.integrated {
-            self.force[i] = model.gravity * model.bodies[i].mass;
+        // 1. applied loads (prescribed bodies collect only what joints and
+        // contacts apply to them: the reaction on a drive)
+        for (i, b) in model.bodies.iter().enumerate() {
+            self.force[i] = if b.is_integrated() {
+                model.gravity * b.mass
+            } else {
+                Vec3::zeros()
+            };
             self.torque[i] = Vec3::zeros();
         }
         for l in &model.torques {
@@ -198,6 +268,7 @@ impl Dynamics {
             }
             for p in &points {
                 let (e, d) = evaluate_point_full(state, pair, p, &self.latched[k]);
+                self.watch.see(k, pair, &e, &d);
                 let f = e.point.normal * e.normal_force + e.tangential_force;
                 let (a, b) = (pair.a, pair.b);
                 self.force[b] += f;
@@ -212,6 +283,20 @@ impl Dynamics {
         }
     }
 
+    /// Whether some pair keeps per-contact memory (latched approach speeds),
+    /// which only [`Mode::Commit`] evaluations update.
+    pub fn has_memory(&self) -> bool {
+        self.latched.iter().any(|l| !l.is_empty())
+    }
+
+    /// Net force and torque on every body at `state` (world frame, torques
+    /// about the centres of mass, no gyroscopic term), left in
+    /// [`Dynamics::forces`] and [`Dynamics::torques`]. For a prescribed body
+    /// these are what the joints and contacts apply to it.
+    pub fn wrenches(&mut self, model: &Model, state: &State, mode: Mode) {
+        self.loads_joints_contacts(model, state, mode, None);
+    }
+
     /// Forces and their velocity Jacobian at `state`, for implicit integrators.
     ///
     /// One force evaluation through the same path as
@@ -222,13 +307,24 @@ impl Dynamics {
     /// D = ∂(wrench)/∂(twist) of the velocity-dependent joint and contact
     /// forces, the geometry (points, normals, depths, joint axes) and latched
     /// approach speeds held fixed. See [`VelocityJacobian`] for the layout.
+    ///
+    /// With `stiffness_scale` s > 0 the blocks hold D + s·K instead, K the
+    /// stiffness (position Jacobian) of the same forces: the Jacobian with
+    /// respect to the velocities when the positions move with them as
+    /// x = x₀ + s·v (an implicit stage of weight s). K holds the normal
+    /// stiffness of each contact point (∂F_n/∂δ along the normal, with the
+    /// friction it carries) and the joint springs and bend stop; the
+    /// geometric terms (normals and lever arms turning with the bodies) are
+    /// left out, which Newton iterations tolerate.
     pub fn forces_and_jacobian(
         &mut self,
         model: &Model,
         state: &State,
         mode: Mode,
+        stiffness_scale: f64,
         jac: &mut VelocityJacobian,
     ) {
+        jac.stiffness_scale = stiffness_scale;
         self.loads_joints_contacts(model, state, mode, Some(jac));
     }
 
@@ -333,9 +429,11 @@ fn evaluate_point(
     evaluate_point_full(state, pair, p, latched).0
 }
 
-/// Velocity derivatives of one contact point's forces.
+/// Derivatives of one contact point's forces.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct PointDerivatives {
+    /// ∂F_n/∂δ [N/m] of the normal law.
+    d_depth: f64,
     /// ∂F_n/∂δ̇ [N·s/m] of the normal law.
     d_rate: f64,
     /// ∂F_t/∂v_t [N·s/m] of the friction law at fixed F_n.
@@ -377,6 +475,7 @@ fn evaluate_point_full(
             slip_speed,
         },
         PointDerivatives {
+            d_depth: normal.d_depth,
             d_rate: normal.d_rate,
             friction,
         },
@@ -426,6 +525,8 @@ pub struct CouplingJacobian {
 pub struct VelocityJacobian {
     /// One entry per contact pair, then one per joint.
     pub couplings: Vec<CouplingJacobian>,
+    /// s of the last [`Dynamics::forces_and_jacobian`]: the blocks hold D + s·K.
+    pub stiffness_scale: f64,
 }
 
 impl VelocityJacobian {
@@ -448,6 +549,7 @@ impl VelocityJacobian {
                     bb: Mat6::zeros(),
                 })
                 .collect(),
+            stiffness_scale: 0.0,
         }
     }
 
@@ -502,7 +604,7 @@ impl VelocityJacobian {
         e: &ContactEval,
         d: &PointDerivatives,
     ) {
-        let g = contact_velocity_gradient(e, d);
+        let g = contact_velocity_gradient(e, d, self.stiffness_scale);
         if g != Mat3::zeros() {
             let p = e.point.point;
             self.add_gradient(k, &g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
@@ -512,14 +614,34 @@ impl VelocityJacobian {
     /// The joint's dampers: −c·(v_b(p_b) − v_a(p_a)) at the hinge points
     /// (arms `ra`, `rb`) and −c_t·(ê·(ω_b − ω_a))·ê on b about the mean x
     /// axis ê ([`twist_axis`]).
+    ///
+    /// With a stiffness scale s the springs add s·k in the same places, and
+    /// an engaged bend stop −s·k_stop·uuᵀ about its axis u.
     fn add_joint(&mut self, k: usize, j: &Joint, state: &State, ra: &Vec3, rb: &Vec3) {
         let p = &j.params;
-        if p.damping != 0.0 {
-            self.add_gradient(k, &(-p.damping * Mat3::identity()), ra, rb);
+        let s = self.stiffness_scale;
+        let linear = p.damping + s * p.stiffness;
+        if linear != 0.0 {
+            self.add_gradient(k, &(-linear * Mat3::identity()), ra, rb);
         }
-        if p.twist_damping != 0.0 {
+        let mut rotational = Mat3::zeros();
+        let twist = p.twist_damping + s * p.twist_stiffness;
+        if twist != 0.0 {
             let axis = twist_axis(&state.rot[j.a], &state.rot[j.b]);
-            let t = p.twist_damping * axis * axis.transpose();
+            rotational += twist * axis * axis.transpose();
+        }
+        if s > 0.0 && p.stop_stiffness != 0.0 {
+            let (ea, eb) = (state.rot[j.a] * Vec3::x(), state.rot[j.b] * Vec3::x());
+            let cross = ea.cross(&eb);
+            let bend = cross.norm().atan2(ea.dot(&eb));
+            if bend > p.bend_limit
+                && let Some(u) = cross.try_normalize(1e-12)
+            {
+                rotational += s * p.stop_stiffness * u * u.transpose();
+            }
+        }
+        if rotational != Mat3::zeros() {
+            let t = rotational;
             let c = &mut self.couplings[k];
             c.active = true;
             let add = |m: &mut Mat6, sign: f64| {
@@ -538,12 +660,17 @@ impl VelocityJacobian {
 /// geometry: the normal law through δ̇ = −n·v_rel, the friction law through
 /// the slip v_t = (I − nnᵀ)·v_rel and through F_n (F_t is proportional to
 /// F_n, so ∂F_t/∂F_n = F_t/F_n).
-fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives) -> Mat3 {
+///
+/// With a stiffness scale s the normal stiffness joins the damping: the
+/// point's relative displacement s·v_rel deepens the contact by −s·n·v_rel,
+/// so ∂F_n/∂δ̇ becomes ∂F_n/∂δ̇ + s·∂F_n/∂δ.
+fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives, s: f64) -> Mat3 {
     let n = e.point.normal;
     let mut g = d.friction * (Mat3::identity() - n * n.transpose());
-    if e.normal_force > 0.0 && d.d_rate != 0.0 {
+    let normal = d.d_rate + s * d.d_depth;
+    if e.normal_force > 0.0 && normal != 0.0 {
         let along = n + e.tangential_force / e.normal_force;
-        g -= d.d_rate * along * n.transpose();
+        g -= normal * along * n.transpose();
     }
     g
 }

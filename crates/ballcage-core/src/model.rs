@@ -110,6 +110,11 @@ pub struct ContactPair {
     pub normal: NormalLaw,
     /// Friction law, if any.
     pub friction: Option<FrictionLaw>,
+    /// Penetration beyond which the run is stopped as diverged [m].
+    pub depth_limit: f64,
+    /// Reduced translational mass of the two bodies [kg] (a body that is not
+    /// integrated counts as infinitely heavy), for the stable-step estimate.
+    pub reduced_mass: f64,
 }
 
 /// A torque `magnitude·axis·STEP(t, 0, 0, ramp, 1)` on a body.
@@ -222,6 +227,11 @@ pub struct Model {
     pub integrator: IntegratorKind,
     /// Integrator step [s].
     pub dt: f64,
+    /// Newton iterations of the `sdirk2` integrator.
+    pub newton: crate::scene::NewtonSpec,
+    /// Largest energy the integrator may create, as a fraction of the
+    /// energy scale ([`crate::scene::DivergenceSpec::energy_growth`]).
+    pub energy_growth: f64,
     /// Steps per recorded frame.
     pub steps_per_output: u64,
     /// Total steps.

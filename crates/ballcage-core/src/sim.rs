@@ -3,13 +3,13 @@
 use std::time::{Duration, Instant};
 
 use crate::assembly::assemble;
-use crate::dynamics::{ContactEval, Dynamics, Energy};
+use crate::dynamics::{ContactEval, ContactWatch, Dynamics, Energy};
 use crate::error::{SceneError, SimulationError};
-use crate::integrate::{self, Workspace};
+use crate::integrate::{self, Stats, Workspace};
 use crate::math::Vec3;
-use crate::model::{Model, State};
+use crate::model::{Model, Motion, State};
 use crate::record::{Recorder, Recording};
-use crate::scene::Scene;
+use crate::scene::{IntegratorKind, Scene};
 
 /// A simulation of one scene.
 #[derive(Debug, Clone)]
@@ -22,6 +22,26 @@ pub struct Simulation {
     scene_toml: String,
     step: u64,
     wall: Duration,
+    /// The divergence that stopped the run, if any.
+    failed: Option<SimulationError>,
+    /// Energy bookkeeping of the divergence check.
+    balance: EnergyBalance,
+    /// The contact watch of the last accepted step (stable-step estimate).
+    last_watch: ContactWatch,
+}
+
+/// Energy put in by drives and applied torques, against which the
+/// mechanical energy may not grow ([`crate::scene::DivergenceSpec::energy_growth`]).
+#[derive(Debug, Clone, Default)]
+struct EnergyBalance {
+    /// Mechanical energy and gravitational potential at t = 0 [J].
+    initial: (f64, f64),
+    /// Net work of the drives and applied torques so far [J].
+    work_in: f64,
+    /// ∫|P| of each input so far [J].
+    work_abs: f64,
+    /// Largest KE + contact energy + |ΔPE_gravity| seen [J].
+    largest: f64,
 }
 
 impl Simulation {
@@ -32,6 +52,11 @@ impl Simulation {
         let workspace = Workspace::new(&state);
         let mut recorder = Recorder::new(&model);
         recorder.record(&model, &state, 0, &mut dynamics);
+        let e0 = dynamics.energy(&model, &state);
+        let balance = EnergyBalance {
+            initial: (e0.total(), e0.potential_gravity),
+            ..EnergyBalance::default()
+        };
         Ok(Self {
             model,
             state,
@@ -41,6 +66,9 @@ impl Simulation {
             scene_toml: scene.to_toml(),
             step: 0,
             wall: Duration::ZERO,
+            failed: None,
+            balance,
+            last_watch: ContactWatch::default(),
         })
     }
 
@@ -71,7 +99,17 @@ impl Simulation {
 
     /// Sparse linear solves so far (zero for the explicit integrators).
     pub fn linear_solves(&self) -> u64 {
-        self.workspace.linear_solves()
+        self.workspace.stats().solves
+    }
+
+    /// Linear solves, LU factorizations and Newton iterations so far.
+    pub fn solver_stats(&self) -> Stats {
+        self.workspace.stats()
+    }
+
+    /// The divergence that stopped the run, if any.
+    pub fn failure(&self) -> Option<&SimulationError> {
+        self.failed.as_ref()
     }
 
     /// Whether the scene's duration has been reached.
@@ -102,22 +140,47 @@ impl Simulation {
     }
 
     /// Takes one integrator step and records a frame when one is due.
+    ///
+    /// The step fails, and every later one with it, when it diverges: a
+    /// non-finite state, a penetration beyond its pair's limit, energy
+    /// created beyond the divergence tolerance (checked at recorded frames),
+    /// or an implicit step that cannot be solved. The error names the time,
+    /// the bodies or pair, and the step the stability estimate says would
+    /// hold; the frames recorded so far stay available to [`Self::finish`].
     pub fn step(&mut self) -> Result<(), SimulationError> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
         let h = self.model.dt;
-        integrate::step(
+        self.dynamics.watch.reset();
+        if let Err(reason) = integrate::step(
             self.model.integrator,
             &self.model,
             &mut self.dynamics,
             &mut self.workspace,
             &mut self.state,
             h,
-        );
+        ) {
+            return self.fail(reason);
+        }
         self.step += 1;
         self.state.t = self.step as f64 * h;
-        self.check_finite()?;
+        if let Some(reason) = self.non_finite() {
+            return self.fail(reason);
+        }
+        if let Some(reason) = self.too_deep() {
+            return self.fail(reason);
+        }
+        self.add_input_work(h);
         if self.step.is_multiple_of(self.model.steps_per_output) {
+            if let Some(reason) = self.energy_created() {
+                return self.fail(reason);
+            }
             self.recorder
                 .record(&self.model, &self.state, self.step, &mut self.dynamics);
+        }
+        if self.dynamics.watch.explicit_step.0.is_finite() {
+            self.last_watch = self.dynamics.watch;
         }
         Ok(())
     }
@@ -149,10 +212,13 @@ impl Simulation {
         self.dynamics.energy(&self.model, &self.state)
     }
 
-    /// Ends the run and hands over the recorded tables with run metadata.
+    /// Ends the run and hands over the recorded tables with run metadata
+    /// (`ballcage.complete` is false, and `ballcage.error` says why, when
+    /// the run stopped early).
     pub fn finish(self) -> Recording {
         let complete = self.is_done();
-        let metadata = vec![
+        let stats = self.workspace.stats();
+        let mut metadata = vec![
             ("ballcage.scene".to_string(), self.scene_toml),
             ("ballcage.version".to_string(), crate::VERSION.to_string()),
             (
@@ -166,11 +232,26 @@ impl Simulation {
                 self.dynamics.evaluations.to_string(),
             ),
             (
+                "ballcage.linear_solves".to_string(),
+                stats.solves.to_string(),
+            ),
+            (
+                "ballcage.factorizations".to_string(),
+                stats.factorizations.to_string(),
+            ),
+            (
+                "ballcage.newton_iterations".to_string(),
+                stats.newton_iterations.to_string(),
+            ),
+            (
                 "ballcage.wall_time_s".to_string(),
                 format!("{:.6}", self.wall.as_secs_f64()),
             ),
             ("ballcage.complete".to_string(), complete.to_string()),
         ];
+        if let Some(e) = &self.failed {
+            metadata.push(("ballcage.error".to_string(), e.to_string()));
+        }
         let tables = self.recorder.finish(&self.model, self.state.t);
         Recording {
             tables,
@@ -180,26 +261,145 @@ impl Simulation {
         }
     }
 
-    fn check_finite(&self) -> Result<(), SimulationError> {
-        for &i in &self.model.integrated {
-            let s = &self.state;
-            let ok = s.pos[i]
-                .iter()
-                .chain(s.vel[i].iter())
-                .chain(s.omega[i].iter())
-                .all(|x| x.is_finite())
-                && s.rot[i].coords.iter().all(|x| x.is_finite());
-            if !ok {
-                return Err(SimulationError {
-                    time: self.state.t,
-                    step: self.step,
-                    reason: format!(
-                        "the state of body `{}` is not finite",
-                        self.model.bodies[i].name
-                    ),
-                });
+    /// Records the failure and returns it, with the stable-step advice.
+    fn fail(&mut self, reason: String) -> Result<(), SimulationError> {
+        let e = SimulationError {
+            time: self.state.t,
+            step: self.step,
+            reason: format!("{reason}; {}", self.step_advice()),
+        };
+        self.failed = Some(e.clone());
+        Err(e)
+    }
+
+    /// What the stability estimate of the last accepted step says about dt.
+    fn step_advice(&self) -> String {
+        let w = if self.last_watch.explicit_step.0.is_finite() {
+            self.last_watch
+        } else {
+            self.dynamics.watch
+        };
+        let kind = self.model.integrator;
+        let dt = self.model.dt;
+        let (estimate, pair) = match kind {
+            IntegratorKind::SymplecticEuler => w.explicit_step,
+            // RK4's stability interval on the real and imaginary axes is
+            // about 2.8 against symplectic Euler's 2.
+            IntegratorKind::Rk4 => (1.4 * w.explicit_step.0, w.explicit_step.1),
+            IntegratorKind::LinearlyImplicitEuler => w.elastic_step,
+            // No stability limit on the linearized contacts: resolve the
+            // stiffest contact's period instead.
+            IntegratorKind::Sdirk2 => (w.period.0 / 10.0, w.period.1),
+        };
+        let Some(p) = self.model.pairs.get(pair).filter(|_| estimate.is_finite()) else {
+            return format!(
+                "no contact was active, so there is no stable-step estimate; \
+                 try simulation.dt = {:.3e} s",
+                dt / 4.0
+            );
+        };
+        let what = if kind == IntegratorKind::Sdirk2 {
+            "a tenth of the stiffest contact's period"
+        } else {
+            "the stability estimate of the stiffest contact"
+        };
+        let advice = if estimate < dt {
+            format!("{what} asks for simulation.dt ≤ {estimate:.3e} s")
+        } else {
+            format!(
+                "{what} ({estimate:.3e} s) is above the step, so the instability is \
+                 elsewhere (joints, gyroscopic terms); try simulation.dt = {:.3e} s",
+                dt / 4.0
+            )
+        };
+        format!(
+            "{advice} with {} (pair `{}`, bodies `{}` and `{}`; the step is {dt:.3e} s)",
+            kind.name(),
+            p.name,
+            self.model.bodies[p.a].name,
+            self.model.bodies[p.b].name
+        )
+    }
+
+    fn non_finite(&self) -> Option<String> {
+        let s = &self.state;
+        self.model
+            .integrated
+            .iter()
+            .find(|&&i| {
+                !(s.pos[i]
+                    .iter()
+                    .chain(s.vel[i].iter())
+                    .chain(s.omega[i].iter())
+                    .all(|x| x.is_finite())
+                    && s.rot[i].coords.iter().all(|x| x.is_finite()))
+            })
+            .map(|&i| {
+                format!(
+                    "the state of body `{}` is not finite",
+                    self.model.bodies[i].name
+                )
+            })
+    }
+
+    fn too_deep(&self) -> Option<String> {
+        let (k, depth, ratio) = self.dynamics.watch.deepest?;
+        if ratio <= 1.0 {
+            return None;
+        }
+        let p = &self.model.pairs[k];
+        Some(format!(
+            "pair `{}` (bodies `{}` and `{}`) penetrates {:.4} mm, beyond its limit of {:.4} mm \
+             (simulation.divergence)",
+            p.name,
+            self.model.bodies[p.a].name,
+            self.model.bodies[p.b].name,
+            depth * 1e3,
+            p.depth_limit * 1e3
+        ))
+    }
+
+    /// Adds the work of the applied torques and of the prescribed bodies
+    /// (minus what the joints and contacts do on them) over the step, from
+    /// the last force evaluation and the new velocities.
+    fn add_input_work(&mut self, h: f64) {
+        let (model, state) = (&self.model, &self.state);
+        let mut add = |p: f64| {
+            self.balance.work_in += p * h;
+            self.balance.work_abs += p.abs() * h;
+        };
+        for l in &model.torques {
+            add(l.torque(state.t).dot(&state.omega_world(l.body)));
+        }
+        let (force, torque) = (self.dynamics.forces(), self.dynamics.torques());
+        for (i, b) in model.bodies.iter().enumerate() {
+            if matches!(b.motion, Motion::KinematicSpin(_)) {
+                add(-(force[i].dot(&state.vel[i]) + torque[i].dot(&state.omega_world(i))));
             }
         }
-        Ok(())
+    }
+
+    /// Checks that the mechanical energy has not grown beyond the input
+    /// work by more than the divergence tolerance.
+    fn energy_created(&mut self) -> Option<String> {
+        let e = self.dynamics.energy(&self.model, &self.state);
+        let b = &mut self.balance;
+        let (e0, pg0) = b.initial;
+        b.largest = b
+            .largest
+            .max(e.kinetic + e.potential_contact + (e.potential_gravity - pg0).abs());
+        let created = e.total() - e0 - b.work_in;
+        let scale = b.largest + b.work_abs;
+        let limit = self.model.energy_growth * scale;
+        (created > limit && created > 1e-9).then(|| {
+            format!(
+                "the integrator created {created:.4e} J of energy (mechanical energy {:.4e} J, \
+                 {e0:.4e} J at the start, input work {:.4e} J), more than \
+                 simulation.divergence.energy_growth = {} of the energy scale {scale:.4e} J",
+                e.total(),
+                b.work_in,
+                self.model.energy_growth
+            )
+        })
     }
 }

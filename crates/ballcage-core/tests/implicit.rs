@@ -12,7 +12,7 @@ use ballcage_core::model::{Model, State};
 /// The wrenches [F; τ] (world frame) of every body of `ids`, stacked.
 fn wrenches(dynamics: &mut Dynamics, model: &Model, state: &State, ids: &[usize]) -> Vec<f64> {
     let mut jac = VelocityJacobian::new(model);
-    dynamics.forces_and_jacobian(model, state, Mode::Trial, &mut jac);
+    dynamics.forces_and_jacobian(model, state, Mode::Trial, 0.0, &mut jac);
     let mut out = vec![];
     for &i in ids {
         out.extend(dynamics.forces()[i].iter());
@@ -43,7 +43,7 @@ fn check_jacobian(sim: &Simulation, rtol: f64) -> usize {
     let mut dynamics = Dynamics::new(model);
     let mut jac = VelocityJacobian::new(model);
     // Latch the approach speeds at this state, then hold them.
-    dynamics.forces_and_jacobian(model, &state, Mode::Commit, &mut jac);
+    dynamics.forces_and_jacobian(model, &state, Mode::Commit, 0.0, &mut jac);
     let dense = jac.to_dense(model.bodies.len());
     let n = 6 * ids.len();
     let mut fd = nalgebra::DMatrix::<f64>::zeros(n, n);

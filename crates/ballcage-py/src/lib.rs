@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use ballcage_core::scene::TableKind;
+use ballcage_core::scene::{IntegratorKind, TableKind};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -242,6 +242,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add(
         "TABLE_NAMES",
         TableKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>(),
+    )?;
+    m.add(
+        "INTEGRATORS",
+        IntegratorKind::ALL
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>(),
     )?;
     Ok(())
 }

@@ -23,9 +23,9 @@ use crate::error::SceneError;
 use crate::geometry::TubePath;
 use crate::math::{Mat3, Quat, Vec3};
 use crate::scene::{
-    BodySpec, ContactSpec, FeatureSpec, FrictionLawSpec, IntegratorKind, JointSpec, LoadSpec,
-    MotionKind, NormalLawSpec, RecordSpec, Scene, ShapeSpec, SimulationSpec, TubeSegmentSpec,
-    WorldSpec, positive,
+    BodySpec, ContactSpec, DivergenceSpec, FeatureSpec, FrictionLawSpec, IntegratorKind, JointSpec,
+    LoadSpec, MotionKind, NewtonSpec, NormalLawSpec, RecordSpec, Scene, ShapeSpec, SimulationSpec,
+    TubeSegmentSpec, WorldSpec, positive,
 };
 use cv::CvGeometry;
 
@@ -359,6 +359,8 @@ impl Default for DrillPipeSpec {
                 dt: 1e-5,
                 output_interval: 1e-3,
                 integrator: IntegratorKind::LinearlyImplicitEuler,
+                newton: NewtonSpec::default(),
+                divergence: DivergenceSpec::default(),
             },
             world: GravitySpec::default(),
             borehole: BoreholeSpec::default(),

@@ -47,6 +47,19 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// Radius of curvature of the shape's surface [m]: ball, cylinder or
+    /// tube radius, the smallest half-extent of a cuboid, infinite for a
+    /// half-space.
+    pub fn radius(&self) -> f64 {
+        match self {
+            Self::Ball(b) => b.radius,
+            Self::Cuboid(c) => c.half_extents.min_element(),
+            Self::HalfSpace(_) => f64::INFINITY,
+            Self::Cylinder { radius, .. } => *radius,
+            Self::Tube(t) => t.inner_radius,
+        }
+    }
+
     /// Builds the query shape of a validated spec.
     pub fn from_spec(spec: &ShapeSpec) -> Self {
         match spec {
@@ -170,6 +183,26 @@ impl PairGeometry {
         canonical(a, b)
             .map(|g| (g, false))
             .or_else(|| canonical(b, a).map(|g| (g, true)))
+    }
+
+    /// The smallest radius of curvature that takes part in the contact [m]
+    /// (ball, cylinder, groove or tube radius, smallest cuboid half-extent;
+    /// a half-space has none), the scale of the penetration limit.
+    pub fn contact_radius(self, s1: &Shape, s2: &Shape) -> f64 {
+        match self {
+            Self::TorusBall {
+                tube_radius,
+                ball_radius,
+                ..
+            } => tube_radius.min(ball_radius),
+            Self::SlotBall { ball_radius, .. } => ball_radius,
+            Self::CavitySphere {
+                cavity_radius,
+                sphere_radius,
+                ..
+            } => cavity_radius.min(sphere_radius),
+            _ => s1.radius().min(s2.radius()),
+        }
     }
 
     /// Number of point slots a pair of this kind can report.

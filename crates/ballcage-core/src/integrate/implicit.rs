@@ -1,7 +1,7 @@
-//! Linearly implicit Euler: a Rosenbrock–Euler step implicit in the
-//! velocity-dependent forces, on the rotation manifold.
+//! The implicit integrators: linearly implicit Euler and SDIRK2, both on the
+//! rotation manifold, sharing one sparse matrix pattern and factorization.
 //!
-//! # Scheme
+//! # Linearly implicit Euler
 //! The unknowns are the twist increments of the integrated bodies in the
 //! world frame: a dynamic body has Δv (3) and Δω (3), a `spin` body the one
 //! spin-rate increment about its axis. Per body a basis B maps them to a
@@ -24,6 +24,33 @@
 //! L-stable backward-Euler amplification; the elastic and gyroscopic terms
 //! stay explicit.
 //!
+//! # SDIRK2
+//! Alexander's two-stage, L-stable, stiffly accurate SDIRK (γ = 1 − 1/√2,
+//! a₁₁ = γ, a₂₁ = 1 − γ, a₂₂ = γ, c = (γ, 1)) applied to x' = v, M v' = f.
+//! The unknowns of stage i are its twists V_i (world frame, as above); the
+//! stage poses follow from them, x_i = x_n + h·Σ_j a_ij·v_j and
+//! R_i = Exp(h·Σ_j a_ij·ω_j)·R_n (second order on the manifold without a
+//! dexp correction). Each stage solves
+//!
+//! r(V_i) = M(x_i)·(V_i − v_n − h·Σ_{j<i} a_ij·A_j) − h·γ·(f − ω×I_wω)(x_i, V_i) = 0
+//!
+//! by simplified Newton iterations with the matrix Bᵀ(M − γh·(D + γh·K))B,
+//! D + γh·K from [`Dynamics::forces_and_jacobian`] with stiffness scale γh
+//! (every force implicit: elastic, damping, friction, joints). ‖Δ‖ is the
+//! largest increment relative to |V| + 1 (m/s or rad/s) and θ = ‖Δ_k‖/‖Δ_{k−1}‖
+//! the contraction rate. A stage has converged when θ < 1 and
+//! θ/(1 − θ)·‖Δ‖ ≤ `newton.tolerance` (the estimated distance to the
+//! solution), or at once when ‖Δ‖ ≤ tolerance/100. The converged stage
+//! gives A_1 = (V_1 − v_n)/(γh); the step ends at stage 2 (stiffly
+//! accurate). The factorization is kept across iterations, stages and
+//! steps: it is re-evaluated at the current iterate when the contraction
+//! is slow (θ > 0.3), and at the next step when a stage took more than
+//! `newton.reuse_iterations`. An increment that makes the residual (in
+//! velocity units, relative to |v_n| + 1) grow — Newton overshooting across a
+//! contact onset or release — is halved, up to 8 times, each halving an
+//! iteration with a fresh Jacobian. A stage that has not converged within
+//! `newton.max_iterations` fails the step.
+//!
 //! # Linear algebra
 //! The sparsity pattern of Bᵀ(M − h·D)B is fixed by the model: a diagonal
 //! block per integrated body and a pair of off-diagonal blocks per declared
@@ -36,7 +63,9 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::lu::{
+    LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
@@ -107,10 +136,10 @@ struct Factorization {
     scratch: Scratch,
 }
 
-/// Workspace of the linearly implicit Euler step: the fixed sparsity pattern,
-/// its symbolic factorization and the per-step buffers.
+/// Workspace of the implicit steps: the fixed sparsity pattern, its symbolic
+/// factorization and the per-step buffers.
 #[derive(Debug, Clone)]
-pub(crate) struct LinearlyImplicit {
+pub(crate) struct Implicit {
     /// Per body: first unknown and basis, `None` if not integrated.
     dofs: Vec<Option<(usize, Basis)>>,
     /// Number of unknowns.
@@ -129,11 +158,47 @@ pub(crate) struct LinearlyImplicit {
     rhs: Vec<f64>,
     /// `None` when there are no unknowns.
     lu: Option<Factorization>,
-    /// Linear solves so far.
-    pub(crate) solves: u64,
+    /// Whether `lu` holds a numeric factorization.
+    factored: bool,
+    /// SDIRK2: whether the next step starts with a fresh Jacobian.
+    refresh: bool,
+    /// SDIRK2 stage data, in unknown coordinates: v_n, the iterate V, the
+    /// stage displacement weights Σ a_ij V_j (without h) and A_1.
+    v_n: Vec<f64>,
+    v: Vec<f64>,
+    base: Vec<f64>,
+    a1: Vec<f64>,
+    /// The last Newton increment, and the mass scale of each unknown
+    /// (m, the largest principal inertia, or the spin inertia).
+    step: Vec<f64>,
+    mass_scale: Vec<f64>,
+    stage: Option<State>,
+    /// Statistics.
+    pub(crate) stats: Stats,
 }
 
-impl LinearlyImplicit {
+/// Work done by an implicit integrator.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Triangular solves with a factorized matrix.
+    pub solves: u64,
+    /// Numeric LU factorizations (each follows a Jacobian evaluation).
+    pub factorizations: u64,
+    /// Newton iterations (SDIRK2).
+    pub newton_iterations: u64,
+}
+
+/// γ of SDIRK2.
+const GAMMA: f64 = 1.0 - std::f64::consts::FRAC_1_SQRT_2;
+
+/// Halvings of one Newton increment before it is taken as it is.
+const MAX_BACKTRACKS: u32 = 8;
+
+/// Contraction rate above which Newton re-evaluates its Jacobian: at 0.3
+/// each iteration gains half a digit; slower is cheaper with a fresh one.
+const REFRESH_CONTRACTION: f64 = 0.3;
+
+impl Implicit {
     /// Builds the sparsity pattern of `model` and factors it symbolically.
     pub(crate) fn new(model: &Model) -> Self {
         let mut dofs = vec![None; model.bodies.len()];
@@ -145,6 +210,19 @@ impl LinearlyImplicit {
             };
             dofs[i] = Some((n, basis));
             n += basis.dim();
+        }
+        let mut mass_scale = vec![0.0; n];
+        for &i in &model.integrated {
+            let (off, basis) = dofs[i].expect("integrated");
+            let body = &model.bodies[i];
+            match (basis, body.motion) {
+                (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass_scale[off] = inertia,
+                _ => {
+                    let rot = body.inertia.max();
+                    mass_scale[off..off + 6]
+                        .copy_from_slice(&[body.mass, body.mass, body.mass, rot, rot, rot]);
+                }
+            }
         }
         let jac = VelocityJacobian::new(model);
         // Row bodies of each column body.
@@ -229,7 +307,16 @@ impl LinearlyImplicit {
             jac,
             rhs: vec![0.0; n],
             lu,
-            solves: 0,
+            factored: false,
+            refresh: true,
+            v_n: vec![0.0; n],
+            v: vec![0.0; n],
+            base: vec![0.0; n],
+            a1: vec![0.0; n],
+            step: vec![0.0; n],
+            mass_scale,
+            stage: None,
+            stats: Stats::default(),
         }
     }
 
@@ -241,9 +328,10 @@ impl LinearlyImplicit {
         state: &mut State,
         h: f64,
     ) {
-        dynamics.forces_and_jacobian(model, state, Mode::Commit, &mut self.jac);
-        self.assemble(model, dynamics, state, h);
-        let solved = self.solve();
+        dynamics.forces_and_jacobian(model, state, Mode::Commit, 0.0, &mut self.jac);
+        self.assemble_matrix(model, state, h);
+        self.euler_rhs(model, dynamics, state, h);
+        let solved = self.factor() && self.solve();
         for &i in &model.integrated {
             let (off, basis) = self.dofs[i].expect("integrated");
             if !solved {
@@ -270,28 +358,291 @@ impl LinearlyImplicit {
         model.prescribe(state.t, state);
     }
 
-    /// Fills Bᵀ(M − h·D)B into `values` and h·Bᵀf into `rhs`.
-    fn assemble(&mut self, model: &Model, dynamics: &Dynamics, state: &State, h: f64) {
-        self.values.fill(0.0);
-        let (force, torque) = (dynamics.forces(), dynamics.torques());
-        for &(i, blk) in &self.diag {
+    /// One SDIRK2 step of `h` seconds; an error names the stage whose Newton
+    /// iterations did not converge.
+    pub(crate) fn sdirk2_step(
+        &mut self,
+        model: &Model,
+        dynamics: &mut Dynamics,
+        state: &mut State,
+        h: f64,
+    ) -> Result<(), String> {
+        if self.n == 0 {
+            // Nothing to integrate: only the prescribed bodies move.
+            state.t += h;
+            model.prescribe(state.t, state);
+            return Ok(());
+        }
+        if dynamics.has_memory() {
+            // Latch contact onsets at the accepted state.
+            dynamics.wrenches(model, state, Mode::Commit);
+        }
+        let mut stage = self.stage.take().unwrap_or_else(|| state.clone());
+        self.gather(model, state);
+        self.v.copy_from_slice(&self.v_n);
+        if !model.newton.reuse_jacobian {
+            self.refresh = true;
+        }
+        let gh = GAMMA * h;
+        let mut worst = 0;
+        let mut result = Ok(());
+        for s in 0..2 {
+            // Known part of the stage velocity and of its displacement.
+            if s == 0 {
+                self.a1.fill(0.0);
+            } else {
+                for k in 0..self.n {
+                    self.a1[k] = (self.v[k] - self.v_n[k]) / gh;
+                }
+            }
+            let t_stage = state.t + if s == 0 { gh } else { h };
+            match self.newton(model, dynamics, state, &mut stage, s, t_stage, h) {
+                Ok(iterations) => worst = worst.max(iterations),
+                Err(e) => {
+                    result = Err(e);
+                    break;
+                }
+            }
+        }
+        self.refresh = result.is_err() || worst > model.newton.reuse_iterations;
+        if result.is_ok() {
+            std::mem::swap(state, &mut stage);
+            state.t = stage.t + h;
+            model.prescribe(state.t, state);
+            stage.clone_from(state);
+        }
+        self.stage = Some(stage);
+        result
+    }
+
+    /// Newton iterations of stage `s` (0 or 1) into `self.v`, `stage` left
+    /// at the converged stage state; returns the iterations taken.
+    #[allow(clippy::too_many_arguments)]
+    fn newton(
+        &mut self,
+        model: &Model,
+        dynamics: &mut Dynamics,
+        start: &State,
+        stage: &mut State,
+        s: usize,
+        t_stage: f64,
+        h: f64,
+    ) -> Result<u32, String> {
+        let gh = GAMMA * h;
+        let settings = &model.newton;
+        let mut previous = f64::INFINITY;
+        let mut last_residual = f64::INFINITY;
+        let mut backtracks = 0;
+        for k in 1..=settings.max_iterations {
+            self.stats.newton_iterations += 1;
+            self.set_stage(model, start, stage, s, t_stage, h);
+            if self.refresh || !self.factored {
+                dynamics.forces_and_jacobian(model, stage, Mode::Trial, gh, &mut self.jac);
+                self.assemble_matrix(model, stage, gh);
+                if !self.factor() {
+                    return Err(format!(
+                        "the Newton matrix of SDIRK2 stage {} is singular",
+                        s + 1
+                    ));
+                }
+                self.refresh = false;
+                previous = f64::INFINITY;
+            } else {
+                dynamics.wrenches(model, stage, Mode::Trial);
+            }
+            self.residual(model, dynamics, stage, s, h);
+            // Line search: an increment that made the residual grow (Newton
+            // overshooting across a contact onset or release) is halved.
+            let residual = self.residual_norm();
+            if residual > last_residual && backtracks < MAX_BACKTRACKS {
+                backtracks += 1;
+                for i in 0..self.n {
+                    self.step[i] *= 0.5;
+                    self.v[i] -= self.step[i];
+                }
+                self.refresh = true;
+                continue;
+            }
+            backtracks = 0;
+            last_residual = residual;
+            if !self.solve() {
+                return Err(format!(
+                    "the Newton increment of SDIRK2 stage {} is not finite",
+                    s + 1
+                ));
+            }
+            let mut norm = 0.0f64;
+            for i in 0..self.n {
+                self.step[i] = self.rhs[i];
+                self.v[i] += self.rhs[i];
+                norm = norm.max(self.rhs[i].abs() / (self.v[i].abs() + 1.0));
+            }
+            // The contraction rate, unknown at the first iteration of a Jacobian.
+            let theta = (previous.is_finite()).then(|| norm / previous);
+            previous = norm;
+            let converged = match theta {
+                _ if norm <= 0.01 * settings.tolerance => true,
+                Some(theta) => theta < 1.0 && theta / (1.0 - theta) * norm <= settings.tolerance,
+                None => false,
+            };
+            if converged {
+                self.set_stage(model, start, stage, s, t_stage, h);
+                return Ok(k);
+            }
+            if theta.is_some_and(|theta| theta > REFRESH_CONTRACTION) {
+                // Slow or diverging: a Jacobian evaluated at this iterate.
+                self.refresh = true;
+            }
+        }
+        Err(format!(
+            "Newton iterations of SDIRK2 stage {} did not converge within \
+             simulation.newton.max_iterations = {} (last increment {previous:.3e} relative, \
+             simulation.newton.tolerance = {:e})",
+            s + 1,
+            settings.max_iterations,
+            settings.tolerance
+        ))
+    }
+
+    /// The largest residual in velocity units (divided by the mass scale),
+    /// relative to |v_n| + 1 (a fixed weight within the step, so that the
+    /// line search compares like with like).
+    fn residual_norm(&self) -> f64 {
+        (0..self.n)
+            .map(|i| self.rhs[i].abs() / (self.mass_scale[i] * (self.v_n[i].abs() + 1.0)))
+            .fold(0.0, f64::max)
+    }
+
+    /// v_n in unknown coordinates from `state` (world twists, spin rates).
+    fn gather(&mut self, model: &Model, state: &State) {
+        for &i in &model.integrated {
             let (off, basis) = self.dofs[i].expect("integrated");
-            let body = &model.bodies[i];
-            match (basis, body.motion) {
+            let w = state.omega_world(i);
+            match basis {
+                Basis::Axis(axis) => self.v_n[off] = w.dot(&axis),
+                Basis::Full => {
+                    for c in 0..3 {
+                        self.v_n[off + c] = state.vel[i][c];
+                        self.v_n[off + 3 + c] = w[c];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Sets `stage` to stage `s` with iterate `self.v`: displacement weights
+    /// γ·V (stage 1) or (1 − γ)·V_1 + γ·V (stage 2, V_1 = v_n + γh·A_1).
+    fn set_stage(
+        &mut self,
+        model: &Model,
+        start: &State,
+        stage: &mut State,
+        s: usize,
+        t_stage: f64,
+        h: f64,
+    ) {
+        for k in 0..self.n {
+            self.base[k] = GAMMA * self.v[k];
+            if s == 1 {
+                let v1 = self.v_n[k] + GAMMA * h * self.a1[k];
+                self.base[k] += (1.0 - GAMMA) * v1;
+            }
+        }
+        stage.t = t_stage;
+        for &i in &model.integrated {
+            let (off, basis) = self.dofs[i].expect("integrated");
+            let (disp, rotvec, vel, w) = match basis {
+                Basis::Axis(axis) => (
+                    Vec3::zeros(),
+                    axis * self.base[off],
+                    start.vel[i],
+                    axis * self.v[off],
+                ),
+                Basis::Full => (
+                    Vec3::new(self.base[off], self.base[off + 1], self.base[off + 2]),
+                    Vec3::new(self.base[off + 3], self.base[off + 4], self.base[off + 5]),
+                    Vec3::new(self.v[off], self.v[off + 1], self.v[off + 2]),
+                    Vec3::new(self.v[off + 3], self.v[off + 4], self.v[off + 5]),
+                ),
+            };
+            stage.pos[i] = start.pos[i] + h * disp;
+            let mut rot = exp_map(&(h * rotvec)) * start.rot[i];
+            rot.renormalize_fast();
+            stage.rot[i] = rot;
+            stage.vel[i] = vel;
+            stage.omega[i] = rot.inverse() * w;
+        }
+        model.prescribe(t_stage, stage);
+    }
+
+    /// −r(V) into `rhs` from the wrenches last evaluated at `stage`:
+    /// r = M·(V − v_n − h(1 − γ)·A_1·[s = 1]) − γh·(f − ω×I_wω).
+    fn residual(&mut self, model: &Model, dynamics: &Dynamics, stage: &State, s: usize, h: f64) {
+        let gh = GAMMA * h;
+        let known = if s == 1 { (1.0 - GAMMA) * h } else { 0.0 };
+        let (force, torque) = (dynamics.forces(), dynamics.torques());
+        let (v, v_n, a1) = (&self.v, &self.v_n, &self.a1);
+        let dv = |k: usize| v[k] - v_n[k] - known * a1[k];
+        for &i in &model.integrated {
+            let (off, basis) = self.dofs[i].expect("integrated");
+            match (basis, model.bodies[i].motion) {
                 (Basis::Axis(axis), Motion::Spin { inertia, .. }) => {
-                    // ω ∥ axis: the gyroscopic torque has no part along it.
+                    self.rhs[off] = -(inertia * dv(off) - gh * torque[i].dot(&axis));
+                }
+                (Basis::Axis(_), _) => unreachable!("only spin bodies have an axis basis"),
+                (Basis::Full, _) => {
+                    let m = model.bodies[i].mass;
+                    let inertia_w = world_inertia(model, stage, i);
+                    let w = stage.omega_world(i);
+                    let tau = torque[i] - w.cross(&(inertia_w * w));
+                    let dw = Vec3::new(dv(off + 3), dv(off + 4), dv(off + 5));
+                    let r_ang = inertia_w * dw - gh * tau;
+                    for c in 0..3 {
+                        self.rhs[off + c] = -(m * dv(off + c) - gh * force[i][c]);
+                        self.rhs[off + 3 + c] = -r_ang[c];
+                    }
+                }
+            }
+        }
+    }
+
+    /// h·Bᵀ(f − ω×I_wω) into `rhs`: the right-hand side of the linearly
+    /// implicit Euler step.
+    fn euler_rhs(&mut self, model: &Model, dynamics: &Dynamics, state: &State, h: f64) {
+        let (force, torque) = (dynamics.forces(), dynamics.torques());
+        for &i in &model.integrated {
+            let (off, basis) = self.dofs[i].expect("integrated");
+            match basis {
+                // ω ∥ axis: the gyroscopic torque has no part along it.
+                Basis::Axis(axis) => self.rhs[off] = h * torque[i].dot(&axis),
+                Basis::Full => {
+                    let inertia_w = world_inertia(model, state, i);
+                    let w = state.omega_world(i);
+                    let tau = torque[i] - w.cross(&(inertia_w * w));
+                    for k in 0..3 {
+                        self.rhs[off + k] = h * force[i][k];
+                        self.rhs[off + 3 + k] = h * tau[k];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Fills Bᵀ(M − hh·J)B into `values`, J the blocks last evaluated into
+    /// `jac` (D, or D + s·K) and M the mass at `state`.
+    fn assemble_matrix(&mut self, model: &Model, state: &State, hh: f64) {
+        self.values.fill(0.0);
+        for &(i, blk) in &self.diag {
+            let body = &model.bodies[i];
+            match (self.dofs[i].expect("integrated").1, body.motion) {
+                (Basis::Axis(_), Motion::Spin { inertia, .. }) => {
                     self.values[self.col_ptr[blk.col0] + blk.row_off] += inertia;
-                    self.rhs[off] = h * torque[i].dot(&axis);
                 }
                 _ => {
-                    let r = state.rot[i].to_rotation_matrix();
-                    let inertia_w: Mat3 =
-                        r.matrix() * Mat3::from_diagonal(&body.inertia) * r.matrix().transpose();
-                    let w = state.rot[i] * state.omega[i];
-                    let gyro = w.cross(&(inertia_w * w));
                     let mut mass = Mat6::zeros();
                     mass.fixed_view_mut::<3, 3>(0, 0).fill_diagonal(body.mass);
-                    mass.fixed_view_mut::<3, 3>(3, 3).copy_from(&inertia_w);
+                    mass.fixed_view_mut::<3, 3>(3, 3)
+                        .copy_from(&world_inertia(model, state, i));
                     add_block(
                         &mut self.values,
                         &self.col_ptr,
@@ -301,11 +652,6 @@ impl LinearlyImplicit {
                         &mass,
                         1.0,
                     );
-                    let tau = torque[i] - gyro;
-                    for k in 0..3 {
-                        self.rhs[off + k] = h * force[i][k];
-                        self.rhs[off + 3 + k] = h * tau[k];
-                    }
                 }
             }
         }
@@ -319,15 +665,14 @@ impl LinearlyImplicit {
                 if let Some(blk) = blk {
                     let bi = self.dofs[i].expect("integrated").1;
                     let bj = self.dofs[j].expect("integrated").1;
-                    add_block(&mut self.values, &self.col_ptr, *blk, bi, bj, m, -h);
+                    add_block(&mut self.values, &self.col_ptr, *blk, bi, bj, m, -hh);
                 }
             }
         }
     }
 
-    /// Factors the assembled matrix and overwrites `rhs` with the solution;
-    /// false if the factorization failed.
-    fn solve(&mut self) -> bool {
+    /// Factors the assembled matrix; false if the factorization failed.
+    fn factor(&mut self) -> bool {
         let Some(lu) = &mut self.lu else {
             return true;
         };
@@ -339,16 +684,40 @@ impl LinearlyImplicit {
         } = lu;
         let a = SparseColMatRef::new(pattern.as_ref(), &self.values);
         let stack = MemStack::new(&mut scratch.buf);
-        let Ok(factors) =
-            symbolic.factorize_numeric_lu(numeric, a, Par::Seq, stack, Default::default())
-        else {
-            return false;
+        self.stats.factorizations += 1;
+        self.factored = symbolic
+            .factorize_numeric_lu(numeric, a, Par::Seq, stack, Default::default())
+            .is_ok();
+        self.factored
+    }
+
+    /// Overwrites `rhs` with the solution of the factorized system; false
+    /// if it is not finite.
+    fn solve(&mut self) -> bool {
+        let Some(lu) = &mut self.lu else {
+            return true;
         };
+        if !self.factored {
+            return false;
+        }
+        // `numeric` is the output of `symbolic.factorize_numeric_lu` on this pattern.
+        let factors = LuRef::new_unchecked(&lu.symbolic, &lu.numeric);
         let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs, self.n, 1);
-        factors.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, MemStack::new(&mut scratch.buf));
-        self.solves += 1;
+        factors.solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut lu.scratch.buf),
+        );
+        self.stats.solves += 1;
         self.rhs.iter().all(|x| x.is_finite())
     }
+}
+
+/// I_w = R·I_b·Rᵀ of body `i` at `state` [kg·m²].
+fn world_inertia(model: &Model, state: &State, i: usize) -> Mat3 {
+    let r = state.rot[i].to_rotation_matrix();
+    r.matrix() * Mat3::from_diagonal(&model.bodies[i].inertia) * r.matrix().transpose()
 }
 
 /// values(block) += scale · B_iᵀ·m·B_j.

@@ -5,10 +5,13 @@
 //! `R = R₀·Exp(ξ)` (Runge–Kutta–Munthe-Kaas), so quaternions never leave the
 //! unit sphere by more than round-off.
 //!
-//! [`IntegratorKind::LinearlyImplicitEuler`] ([`implicit`]) also sees the
-//! velocity Jacobian of the forces, through [`Dynamics::forces_and_jacobian`].
+//! [`IntegratorKind::LinearlyImplicitEuler`] and [`IntegratorKind::Sdirk2`]
+//! ([`implicit`]) also see the Jacobian of the forces, through
+//! [`Dynamics::forces_and_jacobian`].
 
 mod implicit;
+
+pub use implicit::Stats;
 
 use crate::dynamics::{Accel, Dynamics, Mode};
 use crate::math::{Vec3, dexp_inv, exp_map};
@@ -24,8 +27,8 @@ pub struct Workspace {
     /// Rotation-vector rates of the stages [rad/s].
     kq: [Vec<Vec3>; 4],
     stage: State,
-    /// The linearly implicit step's pattern and factorization, built at its first step.
-    implicit: Option<Box<implicit::LinearlyImplicit>>,
+    /// The implicit steps' pattern and factorization, built at the first step.
+    implicit: Option<Box<implicit::Implicit>>,
 }
 
 impl Workspace {
@@ -47,13 +50,20 @@ impl Workspace {
         }
     }
 
-    /// Sparse linear solves so far (the implicit integrators' cost unit).
-    pub fn linear_solves(&self) -> u64 {
-        self.implicit.as_ref().map_or(0, |w| w.solves)
+    /// Linear solves, factorizations and Newton iterations so far (zero for
+    /// the explicit integrators).
+    pub fn stats(&self) -> Stats {
+        self.implicit
+            .as_ref()
+            .map_or_else(Stats::default, |w| w.stats)
     }
 }
 
 /// Advances `state` by one step of `h` seconds with the model's integrator.
+///
+/// An error says why an implicit step could not be solved (the state is then
+/// left at the start of the step). A state that became non-finite is for the
+/// caller to detect.
 pub fn step(
     kind: IntegratorKind,
     model: &Model,
@@ -61,15 +71,22 @@ pub fn step(
     ws: &mut Workspace,
     state: &mut State,
     h: f64,
-) {
+) -> Result<(), String> {
+    fn implicit<'a>(ws: &'a mut Workspace, model: &Model) -> &'a mut implicit::Implicit {
+        ws.implicit
+            .get_or_insert_with(|| Box::new(implicit::Implicit::new(model)))
+    }
     match kind {
         IntegratorKind::SymplecticEuler => symplectic_euler(model, dynamics, ws, state, h),
         IntegratorKind::Rk4 => rk4(model, dynamics, ws, state, h),
-        IntegratorKind::LinearlyImplicitEuler => ws
-            .implicit
-            .get_or_insert_with(|| Box::new(implicit::LinearlyImplicit::new(model)))
-            .step(model, dynamics, state, h),
+        IntegratorKind::LinearlyImplicitEuler => {
+            implicit(ws, model).step(model, dynamics, state, h)
+        }
+        IntegratorKind::Sdirk2 => {
+            return implicit(ws, model).sdirk2_step(model, dynamics, state, h);
+        }
     }
+    Ok(())
 }
 
 /// v ← v + h·a(x, v); x ← x + h·v; R ← R·Exp(h·ω).
