@@ -1,11 +1,14 @@
-"""Command line: ``ballcage run``, ``ballcage paper``, ``ballcage scene show`` and ``ballcage schema``.
+"""Command line: ``ballcage run``, ``paper``, ``accuracy``, ``stability``, ``scene show`` and ``schema``.
 
 ``ballcage run`` without a scene runs the embedded paper scene (Zhu et al.
 2023's drill pipe); ``ballcage scene show`` prints it as TOML to copy and edit.
 ``ballcage paper`` runs it with every table recorded and writes the paper's
 figures and a comparison with its numbers (`ballcage.paper.run_paper`).
+``ballcage accuracy`` and ``ballcage stability`` are the integrator studies of
+`ballcage.studies`.
 
-Exit codes: 0 success; 1 the run failed (`SimulationError`) or its output could
+Exit codes: 0 success; 1 the run failed (`SimulationError`; ``ballcage run``
+then still writes what was recorded, marked incomplete) or its output could
 not be written; 2 bad input (an invalid scene, a missing file, a malformed
 ``--set``, a usage error). Errors are one line on stderr,
 ``ballcage: error: <message>``, never a traceback.
@@ -14,6 +17,8 @@ not be written; 2 bad input (an invalid scene, a missing file, a malformed
 from __future__ import annotations
 
 import argparse
+import math
+import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -28,6 +33,9 @@ __all__ = ["main"]
 PROG = "ballcage"
 #: Output tables, in the order `ballcage schema` prints them.
 TABLE_NAMES: tuple[str, ...] = tuple(_native.TABLE_NAMES)
+#: `ballcage stability --parameters` names (`ballcage.studies.PARAMETER_NAMES`, not imported here:
+#: the studies module pulls in numpy and pyarrow, which the other commands do not need to start).
+STABILITY_PARAMETERS: tuple[str, ...] = ("stiffness", "speed", "curvature_radius", "key_mass", "damping")
 #: What `ballcage run` names the embedded scene in messages.
 DEFAULT_SCENE_NAME = "default scene"
 
@@ -45,17 +53,41 @@ class _Parser(argparse.ArgumentParser):
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``ballcage`` script; returns the exit code."""
-    args = _build_parser().parse_args(argv)
+    given = list(sys.argv[1:] if argv is None else argv)
+    args = _build_parser().parse_args(_attach_negative_numbers(given))
+    args.argv = given
     try:
         return int(args.command(args))
     except (UsageError, _native.SceneError) as e:
         return _fail(str(e), 2)
     except _native.SimulationError as e:
         return _fail(str(e), 1)
+    except _study_error() as e:
+        return _fail(str(e), 1)
     except OSError as e:
         return _fail(f"cannot write output: {e}", 1)
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
+
+
+#: Options whose value may be a (wrong) negative number, which argparse would take for an option.
+_NUMBER_OPTIONS = frozenset({"--steps", "--reference-dt", "--duration", "--values-per-parameter", "--bisections"})
+
+
+def _attach_negative_numbers(argv: Sequence[str]) -> list[str]:
+    """``--steps -1e-5`` → ``--steps=-1e-5``, so the option's own check reports the value."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        arg = argv[i]
+        nxt = argv[i + 1] if i + 1 < len(argv) else ""
+        if arg in _NUMBER_OPTIONS and nxt[:1] == "-" and (nxt[1:2].isdigit() or nxt[1:2] == "."):
+            out.append(f"{arg}={nxt}")
+            i += 2
+            continue
+        out.append(arg)
+        i += 1
+    return out
 
 
 def _build_parser() -> argparse.ArgumentParser:
@@ -98,6 +130,91 @@ def _build_parser() -> argparse.ArgumentParser:
     paper.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
     paper.set_defaults(command=_paper)
 
+    accuracy = commands.add_parser(
+        "accuracy",
+        help="error against run time of each integrator over a ladder of steps (work-precision)",
+        description=(
+            "Run a scene with each integrator over a ladder of steps and compare named quantities (drill pipe: "
+            "peak key-seat force, mean tube force per joint, final link bends, energy; generic scenes: peak force "
+            "per pair, final body states, energy) with a reference: the same scene at a much smaller step with "
+            "the most accurate integrator, also run at twice that step to show it has converged. Writes "
+            "work_precision.parquet, work_precision.png (error against wall time, log-log) and work_precision.md. "
+            "Runs that diverge are recorded as diverged, not errors."
+        ),
+    )
+    accuracy.add_argument(
+        "scene",
+        metavar="SCENE.toml",
+        nargs="?",
+        help="scene file (TOML); without it, the embedded paper scene (use --duration to keep it affordable)",
+    )
+    accuracy.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_integrators_option(accuracy)
+    accuracy.add_argument(
+        "--steps",
+        metavar="[INTEGRATOR=]DT,DT,...",
+        action="append",
+        default=[],
+        help=(
+            "ladder of steps [s] for every integrator, or for one with INTEGRATOR=...; repeatable "
+            "(default: drill pipes 0.1-1 us explicit, 5-200 us implicit; generic scenes 0.25-2x the scene's dt "
+            "explicit, 1-8x implicit)"
+        ),
+    )
+    accuracy.add_argument(
+        "--reference-integrator",
+        metavar="NAME",
+        help="integrator of the reference (default sdirk2 when the engine has it, else linearly-implicit-euler)",
+    )
+    accuracy.add_argument(
+        "--reference-dt",
+        metavar="DT",
+        help="step of the reference [s] (default: the reference integrator's smallest default step / 4)",
+    )
+    accuracy.add_argument("--duration", metavar="S", help="simulated duration [s] (default: the scene's)")
+    _add_set_option(accuracy, example="--set pipe.joints=4 --set 'pipe.hinge=\"ideal-cv\"'")
+    accuracy.add_argument("--quiet", "-q", action="store_true", help="no progress lines and no summary")
+    accuracy.set_defaults(command=_accuracy)
+
+    stability = commands.add_parser(
+        "stability",
+        help="largest stable step of each integrator against stiffness, speed, curvature, key mass, damping",
+        description=(
+            "For each integrator, find the largest step at which a short probe run finishes without a divergence "
+            "error (bracketing by factors of 4, then bisection in log dt), varying one parameter at a time around "
+            "the defaults: contact stiffness of the key and cage contacts (1e3-1e7 N/mm^2.2), drive speed "
+            "(30-600 rpm), curvature radius (from the tightest the hinge allows, pitch / (2 sin(stop / 2)) = "
+            "0.766 m for the paper's pipe, to 5 m), key mass (1/4-4x) and contact damping (0 and 0.1-100 N s/mm). "
+            "The probe scene is the paper's drill pipe with pipe.joints = 2, 0.03 s simulated and the drive and "
+            "load ramped in over 0.01 s (--set and --duration change it). Writes stability.parquet, "
+            "stability_<parameter>.png heat maps (integrator x value, colour log10 max stable dt) and stability.md."
+        ),
+    )
+    stability.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_integrators_option(stability)
+    stability.add_argument(
+        "--parameters",
+        metavar="NAME,...",
+        help=f"parameters to vary (default all: {','.join(STABILITY_PARAMETERS)})",
+    )
+    stability.add_argument(
+        "--values-per-parameter",
+        metavar="N",
+        default="5",
+        help="values of each parameter (default 5, at least 2)",
+    )
+    stability.add_argument("--duration", metavar="S", help="simulated duration of each probe [s] (default 0.03)")
+    stability.add_argument(
+        "--bisections",
+        metavar="N",
+        default="5",
+        help="bisections after bracketing (default 5: the step is found to 4.4%%)",
+    )
+    stability.add_argument("--grid", action="store_true", help="also map every stiffness x speed pair (stability_grid.png)")
+    _add_set_option(stability, example="--set pipe.joints=3 --set 'pipe.hinge=\"ideal-cv\"'")
+    stability.add_argument("--quiet", "-q", action="store_true", help="no progress lines and no summary")
+    stability.set_defaults(command=_stability)
+
     scene = commands.add_parser(
         "scene",
         help="the embedded default scene",
@@ -133,28 +250,56 @@ def _add_set_option(parser: argparse.ArgumentParser, example: str | None = None)
     )
 
 
+def _add_integrators_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--integrators",
+        metavar="NAME,...",
+        help=f"integrators to study (default all: {','.join(_native.INTEGRATORS)})",
+    )
+
+
+def _study_error() -> type[Exception]:
+    from ballcage.studies import StudyError
+
+    return StudyError
+
+
 def _checked_out(out: Path) -> Path:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out} exists and is not a directory")
     return out
 
 
-def _run(args: argparse.Namespace) -> int:
-    overrides = [_checked_override(o) for o in args.overrides]
-    out = _checked_out(args.out)
-    source = _scene_source(args.scene)
+def _load_cli_scene(arg: str | None, overrides: Sequence[str]) -> _native.Scene:
+    """The scene named on the command line (or the embedded one) with `overrides`; bad input is a `UsageError`."""
+    source = _scene_source(arg)
     try:
         if source is None:
-            scene = default_scene(overrides)
-        else:
-            scene = load_scene(source, overrides)
+            return default_scene(overrides)
+        return load_scene(source, overrides)
     except _native.SceneError as e:
         raise UsageError(f"{source or DEFAULT_SCENE_NAME}: {e}") from e
     except OSError as e:  # missing, a directory, unreadable
         raise UsageError(f"{e.strerror or e}: {e.filename or source}") from e
     except UnicodeDecodeError as e:
         raise UsageError(f"{source}: not UTF-8 text ({e.reason} at byte {e.start})") from e
-    result = simulate(scene, progress=False if args.quiet else None)
+
+
+def _run(args: argparse.Namespace) -> int:
+    overrides = [_checked_override(o) for o in args.overrides]
+    out = _checked_out(args.out)
+    scene = _load_cli_scene(args.scene, overrides)
+    try:
+        result = simulate(scene, progress=False if args.quiet else None)
+    except _native.SimulationError as e:
+        partial = getattr(e, "run", None)
+        if partial is None:
+            raise
+        paths = partial.write(out)
+        if not args.quiet:
+            for name, path in paths.items():
+                print(_summary(name, path, partial.tables.get(name)))
+        return _fail(f"{e}; the output in {out} is incomplete (written up to the failure, ballcage.complete = false)", 1)
     paths = result.write(out)
     if not args.quiet:
         for name, path in paths.items():
@@ -165,6 +310,131 @@ def _run(args: argparse.Namespace) -> int:
 def _scene_source(arg: str | None) -> SceneSource | None:
     """The scene named on the command line; ``None`` for the embedded default scene."""
     return arg
+
+
+def _positive(option: str, text: str | None, what: str = "a positive time in seconds") -> float | None:
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise UsageError(f"{option} {text!r}: not a number; give {what}") from None
+    if not (math.isfinite(value) and value > 0):
+        raise UsageError(f"{option} {text}: must be {what}")
+    return value
+
+
+def _count(option: str, text: str, least: int) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise UsageError(f"{option} {text!r}: not a whole number") from None
+    if value < least:
+        raise UsageError(f"{option} {text}: must be at least {least}")
+    return value
+
+
+def _names(option: str, text: str | None, known: Sequence[str], what: str) -> list[str] | None:
+    if text is None:
+        return None
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise UsageError(f"{option} {text!r}: name at least one {what}")
+    for name in names:
+        if name not in known:
+            raise UsageError(f"{option} {name}: unknown {what} (known: {', '.join(known)})")
+    return names
+
+
+def _ladder(option: str, text: str) -> list[float]:
+    steps = []
+    for item in text.split(","):
+        if not item.strip():
+            raise UsageError(f"{option} {text!r}: empty step; write e.g. {option} 1e-5,5e-6")
+        step = _positive(option, item.strip(), "a positive step in seconds")
+        assert step is not None
+        steps.append(step)
+    return steps
+
+
+def _steps_option(texts: Sequence[str], integrators: Sequence[str]) -> list[float] | dict[str, list[float]] | None:
+    """``--steps``: one ladder for all (``1e-5,5e-6``) and/or per integrator (``rk4=1e-6,5e-7``)."""
+    common: list[float] | None = None
+    per: dict[str, list[float]] = {}
+    for text in texts:
+        name, sep, ladder = text.partition("=")
+        if sep:
+            name = name.strip()
+            if name not in integrators:
+                raise UsageError(f"--steps {text}: {name!r} is not one of the studied integrators ({', '.join(integrators)})")
+            per[name] = _ladder("--steps", ladder)
+        else:
+            common = _ladder("--steps", text)
+    if not per:
+        return common
+    if common is not None:
+        for name in integrators:
+            per.setdefault(name, common)
+    return per
+
+
+def _accuracy(args: argparse.Namespace) -> int:
+    from ballcage.studies import accuracy, write_accuracy  # deferred: numpy, matplotlib
+
+    known = list(_native.INTEGRATORS)
+    integrators = _names("--integrators", args.integrators, known, "integrator") or known
+    reference = _names("--reference-integrator", args.reference_integrator, known, "integrator")
+    steps = _steps_option(args.steps, integrators)
+    reference_dt = _positive("--reference-dt", args.reference_dt, "a positive step in seconds")
+    duration = _positive("--duration", args.duration)
+    overrides = [_checked_override(o) for o in args.overrides]
+    out = _checked_out(args.out)
+    scene = _load_cli_scene(args.scene, overrides)
+    table = accuracy(
+        scene,
+        integrators=integrators,
+        steps=steps,
+        reference_integrator=reference[0] if reference else None,
+        reference_dt=reference_dt,
+        duration=duration,
+        progress=not args.quiet,
+    )
+    paths = write_accuracy(table, out, command=shlex.join([PROG, *args.argv]))
+    if not args.quiet:
+        for path in paths.values():
+            print(f"wrote {path}  ({_human_size(path.stat().st_size)})")
+    return 0
+
+
+def _stability(args: argparse.Namespace) -> int:
+    from ballcage.studies import probe_scene, stability, write_stability  # deferred: numpy, matplotlib
+
+    known = list(_native.INTEGRATORS)
+    integrators = _names("--integrators", args.integrators, known, "integrator") or known
+    parameters = _names("--parameters", args.parameters, STABILITY_PARAMETERS, "parameter")
+    values = _count("--values-per-parameter", args.values_per_parameter, 2)
+    bisections = _count("--bisections", args.bisections, 0)
+    duration = _positive("--duration", args.duration)
+    overrides = [_checked_override(o) for o in args.overrides]
+    out = _checked_out(args.out)
+    try:
+        scene = probe_scene(overrides, duration)
+    except _native.SceneError as e:
+        raise UsageError(f"{DEFAULT_SCENE_NAME}: {e}") from e
+    table = stability(
+        scene,
+        parameters=parameters if parameters is not None else list(STABILITY_PARAMETERS),
+        integrators=integrators,
+        values_per_parameter=values,
+        grid=args.grid,
+        bisections=bisections,
+        progress=not args.quiet,
+    )
+    paths = write_stability(table, out, command=shlex.join([PROG, *args.argv]))
+    if not args.quiet:
+        for path in paths.values():
+            print(f"wrote {path}  ({_human_size(path.stat().st_size)})")
+    return 0
 
 
 def _paper(args: argparse.Namespace) -> int:

@@ -37,9 +37,11 @@ class Run:
     ``"energy"``) to a `pyarrow.Table`; units are in each field's metadata.
     """
 
-    def __init__(self, tables: Mapping[str, pa.Table], scene_toml: str) -> None:
+    def __init__(self, tables: Mapping[str, pa.Table], scene_toml: str, *, error: str | None = None) -> None:
         self.tables: dict[str, pa.Table] = dict(tables)
         self._scene_toml = scene_toml
+        #: Why the run stopped early (the `SimulationError` message); ``None`` for a complete run.
+        self.error: str | None = error
 
     @property
     def bodies(self) -> pa.Table:
@@ -63,6 +65,13 @@ class Run:
             raw = table.schema.metadata or {}
             return {k.decode(): v.decode() for k, v in raw.items()}
         return {}
+
+    @property
+    def complete(self) -> bool:
+        """Whether the run reached the scene's duration (``ballcage.complete`` in the metadata)."""
+        if self.error is not None:
+            return False
+        return self.metadata.get("ballcage.complete", "true") == "true"
 
     @property
     def scene_toml(self) -> str:
@@ -124,7 +133,10 @@ def simulate(
     more than 1.5 s, ``True`` shows it from the start, ``False`` never.
 
     Raises `ballcage.SceneError` for an invalid scene and
-    `ballcage.SimulationError` when the run diverges.
+    `ballcage.SimulationError` when the run diverges. The error then carries
+    what was recorded up to the failure as ``e.run``, a `Run` whose metadata
+    has ``ballcage.complete = "false"`` and ``ballcage.error`` (the message);
+    ``e.run.write(dir)`` writes it like a complete run.
     """
     resolved = load_scene(scene, overrides)
     sim = _native.Simulation(resolved)
@@ -134,6 +146,11 @@ def simulate(
         for i in range(1, CHUNKS + 1):
             sim.advance(duration if i == CHUNKS else duration * i / CHUNKS)
             bar.update(sim.time)
+    except _native.SimulationError as e:
+        # The native Simulation stays usable after an error: hand over what it
+        # recorded (its metadata has ballcage.complete = "false" and ballcage.error).
+        e.run = Run(sim.finish(), resolved.to_toml(), error=str(e))  # type: ignore[attr-defined]
+        raise
     finally:
         bar.close()
     return Run(sim.finish(), resolved.to_toml())

@@ -49,10 +49,11 @@ fn main() {
     }
     let st = sim.solver_stats();
     println!(
-        "force evaluations {} factorizations {} solves {} newton iterations {}",
+        "force evaluations {} factorizations {} solves {} newton iterations {} halvings {}",
         sim.force_evaluations(),
         st.factorizations,
         st.solves,
-        st.newton_iterations
+        st.newton_iterations,
+        st.halvings
     );
 }

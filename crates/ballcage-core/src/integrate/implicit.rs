@@ -49,7 +49,9 @@
 //! velocity units, relative to |v_n| + 1) grow — Newton overshooting across a
 //! contact onset or release — is halved, up to 8 times, each halving an
 //! iteration with a fresh Jacobian. A stage that has not converged within
-//! `newton.max_iterations` fails the step.
+//! `newton.max_iterations` fails the step, which is then retried as two
+//! half steps, down to a sixteenth (many contacts switching within one
+//! step); the run fails only when that does not converge either.
 //!
 //! # Linear algebra
 //! The sparsity pattern of Bᵀ(M − h·D)B is fixed by the model: a diagonal
@@ -162,6 +164,8 @@ pub(crate) struct Implicit {
     factored: bool,
     /// SDIRK2: whether the next step starts with a fresh Jacobian.
     refresh: bool,
+    /// SDIRK2: the γh the factorized matrix was built with.
+    factored_gh: f64,
     /// SDIRK2 stage data, in unknown coordinates: v_n, the iterate V, the
     /// stage displacement weights Σ a_ij V_j (without h) and A_1.
     v_n: Vec<f64>,
@@ -186,10 +190,16 @@ pub struct Stats {
     pub factorizations: u64,
     /// Newton iterations (SDIRK2).
     pub newton_iterations: u64,
+    /// Steps (or part steps) retried as two halves because Newton did not
+    /// converge (SDIRK2).
+    pub halvings: u64,
 }
 
 /// γ of SDIRK2.
 const GAMMA: f64 = 1.0 - std::f64::consts::FRAC_1_SQRT_2;
+
+/// Halvings of a step whose Newton iterations do not converge.
+const MAX_HALVINGS: u32 = 4;
 
 /// Halvings of one Newton increment before it is taken as it is.
 const MAX_BACKTRACKS: u32 = 8;
@@ -309,6 +319,7 @@ impl Implicit {
             lu,
             factored: false,
             refresh: true,
+            factored_gh: 0.0,
             v_n: vec![0.0; n],
             v: vec![0.0; n],
             base: vec![0.0; n],
@@ -358,9 +369,41 @@ impl Implicit {
         model.prescribe(state.t, state);
     }
 
-    /// One SDIRK2 step of `h` seconds; an error names the stage whose Newton
-    /// iterations did not converge.
+    /// One SDIRK2 step of `h` seconds. A step whose Newton iterations do not
+    /// converge is retried as two half steps, down to h/16; an error names
+    /// the stage that still did not converge (the state is then unchanged).
     pub(crate) fn sdirk2_step(
+        &mut self,
+        model: &Model,
+        dynamics: &mut Dynamics,
+        state: &mut State,
+        h: f64,
+    ) -> Result<(), String> {
+        self.sdirk2_split(model, dynamics, state, h, 0)
+    }
+
+    fn sdirk2_split(
+        &mut self,
+        model: &Model,
+        dynamics: &mut Dynamics,
+        state: &mut State,
+        h: f64,
+        depth: u32,
+    ) -> Result<(), String> {
+        match self.sdirk2_single(model, dynamics, state, h) {
+            Err(_) if depth < MAX_HALVINGS => {
+                self.stats.halvings += 1;
+                self.sdirk2_split(model, dynamics, state, h / 2.0, depth + 1)?;
+                self.sdirk2_split(model, dynamics, state, h / 2.0, depth + 1)
+            }
+            Err(e) => Err(format!(
+                "{e} (with the step halved {MAX_HALVINGS} times, to {h:.3e} s)"
+            )),
+            Ok(()) => Ok(()),
+        }
+    }
+
+    fn sdirk2_single(
         &mut self,
         model: &Model,
         dynamics: &mut Dynamics,
@@ -436,7 +479,7 @@ impl Implicit {
         for k in 1..=settings.max_iterations {
             self.stats.newton_iterations += 1;
             self.set_stage(model, start, stage, s, t_stage, h);
-            if self.refresh || !self.factored {
+            if self.refresh || !self.factored || self.factored_gh != gh {
                 dynamics.forces_and_jacobian(model, stage, Mode::Trial, gh, &mut self.jac);
                 self.assemble_matrix(model, stage, gh);
                 if !self.factor() {
@@ -446,6 +489,7 @@ impl Implicit {
                     ));
                 }
                 self.refresh = false;
+                self.factored_gh = gh;
                 previous = f64::INFINITY;
             } else {
                 dynamics.wrenches(model, stage, Mode::Trial);

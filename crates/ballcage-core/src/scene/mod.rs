@@ -127,8 +127,12 @@ pub struct DivergenceSpec {
     /// Largest allowed energy created by the integrator: the run stops when
     /// E(t) − E(0) − W_in(t) (mechanical energy gained beyond the work of the
     /// drives and applied torques) exceeds this fraction of the energy scale
-    /// max(|E|) + ∫|P_in| dt, checked at every recorded frame [–]. PROPOSAL:
-    /// 0.05.
+    /// KE(0) + E_contact(0) + max|ΔPE_gravity| + ∫|P_in| dt (the most the
+    /// system could hold), checked at every recorded frame [–]. PROPOSAL:
+    /// 1.0 — the integrator has made as much energy again as the system
+    /// holds or was given; a diverging run passes that within a few steps,
+    /// while a stable explicit run near its step limit (symplectic Euler's
+    /// energy swings by up to 1/(1 − (hω/2)²)) does not.
     pub energy_growth: f64,
 }
 
@@ -137,7 +141,7 @@ impl Default for DivergenceSpec {
         Self {
             penetration_fraction: 0.25,
             max_penetration: None,
-            energy_growth: 0.05,
+            energy_growth: 1.0,
         }
     }
 }

@@ -1,0 +1,141 @@
+"""A diverging run keeps what it recorded: `e.run` in Python, incomplete Parquet files from the CLI (exit 1)."""
+
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import ballcage
+from ballcage import cli
+
+M, R, K = 1.0, 0.05, 1e8  # kg, m, N/m
+DT = 1e-3  # s: h·ω = DT·sqrt(2K/M) ≈ 14, far beyond symplectic Euler's bound of 2
+DURATION = 1.0  # s
+OUTPUT_INTERVAL = DT  # s: a frame every step, so the few steps before the failure are recorded
+FULL_FRAMES = round(DURATION / OUTPUT_INTERVAL) + 1
+
+
+def stiff_slot() -> ballcage.SceneBuilder:
+    """A ball pressed between two planes by stiff linear springs (0.1 mm preload each side).
+
+    It cannot escape, so at h·ω ≈ 14 the symplectic Euler amplitude grows by
+    about (h·ω)² ≈ 200 per step: within a few steps the penetration exceeds
+    the pair's limit, and within a few hundred the state is non-finite,
+    either way long before the 1 s duration.
+    """
+    spring = {"law": "linear", "stiffness": K}
+    return (
+        ballcage.SceneBuilder("stiff slot")
+        .simulation(duration=DURATION, dt=DT, output_interval=OUTPUT_INTERVAL, integrator="symplectic-euler")
+        .body("ground", motion="fixed", shape={"type": "half-space", "normal": [0.0, 0.0, 1.0]})
+        .body(
+            "ceiling",
+            motion="fixed",
+            shape={"type": "half-space", "normal": [0.0, 0.0, -1.0]},
+            position=[0.0, 0.0, 2 * R - 2e-4],
+        )
+        .body("ball", shape={"type": "ball", "radius": R}, mass=M, position=[0.0, 0.0, R - 1e-4], velocity=[0.0, 0.0, 1e-3])
+        .contact("ground", "ball", normal=spring)
+        .contact("ceiling", "ball", normal=spring)
+        .record(tables=["bodies", "contacts", "energy", "summary"])
+    )
+
+
+def _failure_time(message: str) -> float | None:
+    """The time the engine's message names (``... at t = 1.56e-1 s ...``), if it names one."""
+    match = re.search(r"t = ([-+0-9.eE]+) s", message)
+    return float(match.group(1)) if match else None
+
+
+def test_diverging_run_raises_with_the_partial_run_attached():
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(stiff_slot())
+    e = info.value
+    run = e.run
+    assert isinstance(run, ballcage.Run)
+    assert not run.complete
+    assert run.error == str(e)
+    assert set(run.tables) == {"bodies", "contacts", "energy", "summary"}
+
+    meta = run.metadata
+    assert meta["ballcage.complete"] == "false"
+    assert meta["ballcage.error"]  # the engine's or ours: one message either way
+    assert meta["ballcage.integrator"] == "symplectic-euler"
+    assert int(meta["ballcage.steps"]) < round(DURATION / DT)
+
+    t = run.bodies["t"].to_numpy()
+    assert 2 <= len(t) < FULL_FRAMES
+    assert t[0] == 0.0
+    assert t.max() < DURATION
+    t_fail = _failure_time(str(e))
+    if t_fail is not None:
+        assert t.max() <= t_fail + 1e-12
+    np.testing.assert_array_less(run.energy["t"].to_numpy(), DURATION)
+    # Recorded frames are the ones before the failure: all finite.
+    assert np.all(np.isfinite(run.bodies["pos_z"].to_numpy()))
+    # The field metadata (units) survives the added schema metadata.
+    assert run.bodies.schema.field("pos_z").metadata[b"unit"] == b"m"
+    for table in run.tables.values():
+        assert table.schema.metadata[b"ballcage.complete"] == b"false"
+
+
+def test_error_metadata_is_the_message_once_whoever_writes_it():
+    # The engine writes ballcage.error itself; simulate() adds it only when missing.
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(stiff_slot())
+    for table in info.value.run.tables.values():
+        meta = table.schema.metadata
+        assert [k for k in meta if k == b"ballcage.error"] == [b"ballcage.error"]
+        assert meta[b"ballcage.error"].decode() == str(info.value)
+
+
+def test_a_complete_run_has_no_error():
+    run = ballcage.simulate(stiff_slot().simulation(dt=1e-5, output_interval=1e-3, duration=0.01))  # h·ω ≈ 0.14
+    assert run.complete
+    assert run.error is None
+    assert "ballcage.error" not in run.metadata
+
+
+def test_cli_writes_the_incomplete_output_and_exits_1(tmp_path, capsys):
+    scene = tmp_path / "slot.toml"
+    scene.write_text(ballcage.load_scene(stiff_slot()).to_toml(), encoding="utf-8")
+    out = tmp_path / "out"
+
+    code = cli.main(["run", str(scene), "--out", str(out)])
+
+    captured = capsys.readouterr()
+    assert code == 1
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1
+    assert lines[0].startswith("ballcage: error: ")
+    assert "diverged" in lines[0] and "incomplete" in lines[0]
+    assert "Traceback" not in captured.err
+    assert "wrote" in captured.out
+
+    for name in ("bodies", "contacts", "energy", "summary"):
+        path = out / f"{name}.parquet"
+        assert path.is_file(), name
+        meta = pq.read_schema(path).metadata
+        assert meta[b"ballcage.complete"] == b"false"
+        assert meta[b"ballcage.error"]
+    assert (out / "scene.toml").is_file()
+    assert not list(out.glob(".*.tmp"))  # atomic writes leave no temporaries
+    bodies = pq.read_table(out / "bodies.parquet")
+    assert 0 < bodies.num_rows < FULL_FRAMES
+    assert bodies["t"].to_numpy().max() < DURATION
+    assert math.isfinite(float(bodies["pos_z"].to_numpy()[-1]))
+
+
+def test_cli_quiet_still_writes_and_reports_one_line(tmp_path, capsys):
+    scene = tmp_path / "slot.toml"
+    scene.write_text(ballcage.load_scene(stiff_slot()).to_toml(), encoding="utf-8")
+    code = cli.main(["run", str(scene), "--out", str(tmp_path / "q"), "--quiet"])
+    captured = capsys.readouterr()
+    assert code == 1
+    assert captured.out == ""
+    assert len(captured.err.strip().splitlines()) == 1
+    assert (tmp_path / "q" / "bodies.parquet").is_file()
