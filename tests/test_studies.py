@@ -334,6 +334,13 @@ def test_stability_heat_maps_are_written(slot_stability, tmp_path):
 def test_tightest_radius_is_the_articulation_stop_over_the_pitch():
     assert studies.tightest_radius() == pytest.approx(0.2 / (2 * math.sin(math.radians(7.5))), rel=1e-12)
     assert studies.tightest_radius() == pytest.approx(0.766, abs=1e-3)
+
+
+def test_tightest_radius_is_eq9_when_the_stop_allows_more():
+    # A 120° stop would allow R = 0.2 / (2 sin 60°) = 0.115 m; the 86 mm link
+    # in the 116 mm tube fits only down to R = 0.1² / (2·0.030) − 0.043 = 0.1237 m (eq. (9)).
+    scene = ballcage.load_scene({"kind": "drill-pipe", "pipe": {"ball_keys": {"bend_limit_deg": 120.0}}})
+    assert studies.tightest_radius(scene) == pytest.approx(0.01 / 0.06 - 0.043, rel=1e-12)
     params = studies.drill_pipe_parameters(values_per_parameter=5)
     assert tuple(params) == studies.PARAMETER_NAMES == cli.STABILITY_PARAMETERS
     assert params["stiffness"].values == pytest.approx((1e3, 1e4, 1e5, 1e6, 1e7))

@@ -15,6 +15,9 @@ All quantities are SI; units are in each output column's field metadata.
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
 `ballcage.paper.run_paper(dir)` runs it and writes the tables, the paper's
 figures and a comparison with the paper's numbers (``ballcage paper``).
+`ballcage.studies.accuracy` and `ballcage.studies.stability` measure what
+each integrator's step costs in error and where it stops being stable
+(``ballcage accuracy``, ``ballcage stability``).
 """
 
 from __future__ import annotations
@@ -57,7 +60,7 @@ _warn_if_debug_build(_native.BUILD_PROFILE)
 
 
 def __getattr__(name: str) -> Any:
-    """Imports `ballcage.paper` (and with it matplotlib) only when it is first used."""
-    if name == "paper":
-        return importlib.import_module("ballcage.paper")
+    """Imports `ballcage.paper` and `ballcage.studies` (and with them matplotlib) only when first used."""
+    if name in ("paper", "studies"):
+        return importlib.import_module(f"ballcage.{name}")
     raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

@@ -861,13 +861,17 @@ DAMPING_RANGE = (0.1, 100.0)  # N·s/mm, plus zero
 
 
 def tightest_radius(scene: SceneSource | None = None) -> float:
-    """The tightest tube curvature radius [m] the hinge allows: pitch / (2 sin(bend_limit / 2)).
+    """The tightest tube curvature radius [m] the hinge allows, whichever binds first of:
 
-    On an arc of radius R, links of pitch p bend by 2·asin(p / 2R) at each
-    joint; the articulation stop (``pipe.ball_keys.bend_limit_deg`` or
-    ``pipe.ideal_cv.bend_limit_deg``) bounds that. The paper's 200 mm pitch
-    and 15° stop give 0.766 m. (The guide tube's own clearance condition,
-    the paper's eq. (9), is not evaluated here.)
+    * the articulation stop: on an arc of radius R, links of pitch p bend by
+      2·asin(p / 2R) at each joint, which ``bend_limit_deg`` (ball keys or ideal
+      CV) bounds: R = p / (2 sin(limit / 2)) — 0.766 m for the paper's 200 mm
+      pitch and 15° stop;
+    * the paper's eq. (9), the longest rigid link of radius r that fits the
+      tube (diameter D): L = 2·√(2(D − 2r)(R + r)), so R = (p/2)² / (2(D − 2r)) − r
+      — 0.124 m for the paper's 86 mm links in the 116 mm tube.
+
+    The stop binds first for the paper's pipe.
     """
     spec = _scene_dict(_resolve(scene, ()))
     if spec.get("kind") != "drill-pipe":
@@ -875,7 +879,12 @@ def tightest_radius(scene: SceneSource | None = None) -> float:
     pipe = spec["pipe"]
     hinge = "ideal_cv" if pipe.get("hinge") == "ideal-cv" else "ball_keys"
     limit = math.radians(float(pipe[hinge]["bend_limit_deg"]))
-    return float(pipe["pitch"]) / (2.0 * math.sin(limit / 2.0))
+    pitch = float(pipe["pitch"])
+    stop = pitch / (2.0 * math.sin(limit / 2.0))
+    r = float(pipe["link_diameter"]) / 2.0
+    gap = float(spec["borehole"]["inner_diameter"]) - 2.0 * r
+    eq9 = (pitch / 2.0) ** 2 / (2.0 * gap) - r if gap > 0 else math.inf
+    return max(stop, eq9)
 
 
 def drill_pipe_parameters(scene: SceneSource | None = None, values_per_parameter: int = 5) -> dict[str, Parameter]:

@@ -30,6 +30,34 @@ fn scene(n: usize) -> Scene {
     Scene::from_toml_str(&toml, &[]).expect("valid bench scene")
 }
 
+/// The paper's drill pipe (12 ball-key joints, 106 bodies, 506 pairs) for
+/// the first 5 ms, with each implicit integrator at its recommended step
+/// (docs/accuracy.md).
+fn paper(c: &mut Criterion) {
+    let mut g = c.benchmark_group("paper scene, first 5 ms");
+    g.sample_size(10);
+    for (integrator, dt) in [("linearly-implicit-euler", 1e-5), ("sdirk2", 2e-5)] {
+        let s = Scene::from_toml_str(
+            "kind = \"drill-pipe\"\n",
+            &[
+                format!("simulation.integrator=\"{integrator}\""),
+                format!("simulation.dt={dt}"),
+                "simulation.duration=0.005".to_string(),
+                "record.tables=[]".to_string(),
+            ],
+        )
+        .expect("valid paper scene");
+        g.bench_function(format!("{integrator} at {dt} s"), |b| {
+            b.iter(|| {
+                let mut sim = Simulation::new(&s).expect("assembles");
+                sim.run().expect("stable");
+                sim.steps()
+            })
+        });
+    }
+    g.finish();
+}
+
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("rk4 1000 steps, keys resting on a plane");
     g.sample_size(10);
@@ -46,5 +74,5 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, paper);
 criterion_main!(benches);
