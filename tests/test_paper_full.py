@@ -57,7 +57,7 @@ def _positions(run: ballcage.Run, body: str) -> np.ndarray:
 
 def test_the_run_completes_without_non_finite_values(paper_run):
     assert paper_run.metadata["ballcage.complete"] == "true"
-    assert paper_run.metadata["ballcage.integrator"] == "linearly-implicit-euler"
+    assert paper_run.metadata["ballcage.integrator"] == "sdirk2"
     for name, table in paper_run.tables.items():
         for column in table.column_names:
             values = table[column]

@@ -193,6 +193,19 @@ def test_reference_self_error_is_recorded_and_small(spin_study):
     assert float(table.schema.metadata[b"ballcage.reference_self_error_max"]) < 1e-8
 
 
+def test_a_study_where_every_run_diverged_still_writes_its_files(tmp_path):
+    table = studies.accuracy(
+        slot(1e8, duration=0.02),
+        integrators=["symplectic-euler"],
+        steps=[1e-3],
+        reference_integrator="rk4",
+        reference_dt=1e-6,
+    )
+    assert all(r["diverged"] for r in _rows(table, role="run"))
+    paths = studies.write_accuracy(table, tmp_path)
+    assert all(p.stat().st_size > 0 for p in paths.values())
+
+
 def test_diverged_runs_are_rows_not_errors():
     # h·ω = 1e-3 · sqrt(2e8) ≈ 14 ≫ 2: symplectic Euler diverges; 1e-5 s is stable (h·ω ≈ 0.14).
     table = studies.accuracy(

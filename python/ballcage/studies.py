@@ -753,6 +753,7 @@ def _accuracy_figure(table: pa.Table) -> Figure:
     ladder = [r for r in runs if r["role"] == "run"]
     order = list(dict.fromkeys(r["integrator"] for r in ladder))
     for ax, quantity in zip(axes, panels, strict=False):
+        drawn = False
         for integrator in order:
             mine = sorted((r for r in ladder if r["integrator"] == integrator), key=lambda r: -r["dt"])
             points = [(r["wall_s"], r["errors"].get(quantity), r["dt"]) for r in mine]
@@ -760,6 +761,7 @@ def _accuracy_figure(table: pa.Table) -> Figure:
             diverged = sum(1 for r in mine if r["diverged"])
             label = integrator + (f" ({diverged} diverged)" if diverged else "")
             if ok:
+                drawn = True
                 (line,) = ax.loglog([p[0] for p in ok], [p[1] for p in ok], marker="o", label=label)
                 for w, e, dt in ok:
                     ax.annotate(f"{dt:.2g}", (w, e), textcoords="offset points", xytext=(4, 3), fontsize=6, color=line.get_color())
@@ -769,8 +771,11 @@ def _accuracy_figure(table: pa.Table) -> Figure:
         if ref_err is not None and math.isfinite(ref_err) and ref_err > 0:
             ax.axhline(ref_err, color="0.5", ls="--", lw=1, label="reference self-error")
         ax.set(xlabel="wall time [s]", ylabel="relative error", title=quantity.replace("_", " "))
-        ax.set_xscale("log")
-        ax.set_yscale("log")
+        if drawn:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        else:
+            ax.text(0.5, 0.5, "no finite error: every run diverged", transform=ax.transAxes, ha="center", fontsize=8)
         ax.grid(True, which="both", lw=0.3, alpha=0.5)
         ax.legend(fontsize=7)
     for ax in axes[len(panels) :]:

@@ -30,6 +30,15 @@ pub struct Simulation {
     last_watch: ContactWatch,
 }
 
+/// What stopped a run, for the advice in its error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Failure {
+    /// A penetration beyond its pair's limit (possibly physical).
+    Penetration,
+    /// Anything else (non-finite state, energy created, Newton failure).
+    Numerical,
+}
+
 /// Energy put in by drives and applied torques, against which the
 /// mechanical energy may not grow ([`crate::scene::DivergenceSpec::energy_growth`]).
 #[derive(Debug, Clone, Default)]
@@ -175,7 +184,7 @@ impl Simulation {
             return self.fail(reason);
         }
         if let Some(reason) = self.too_deep() {
-            return self.fail(reason);
+            return self.fail_with(reason, Failure::Penetration);
         }
         self.add_input_work(h);
         if self.step.is_multiple_of(self.model.steps_per_output) {
@@ -273,17 +282,21 @@ impl Simulation {
 
     /// Records the failure and returns it, with the stable-step advice.
     fn fail(&mut self, reason: String) -> Result<(), SimulationError> {
+        self.fail_with(reason, Failure::Numerical)
+    }
+
+    fn fail_with(&mut self, reason: String, kind: Failure) -> Result<(), SimulationError> {
         let e = SimulationError {
             time: self.state.t,
             step: self.step,
-            reason: format!("{reason}; {}", self.step_advice()),
+            reason: format!("{reason}; {}", self.step_advice(kind)),
         };
         self.failed = Some(e.clone());
         Err(e)
     }
 
     /// What the stability estimate of the last accepted step says about dt.
-    fn step_advice(&self) -> String {
+    fn step_advice(&self, failure: Failure) -> String {
         let w = if self.last_watch.explicit_step.0.is_finite() {
             self.last_watch
         } else {
@@ -315,6 +328,14 @@ impl Simulation {
         };
         let advice = if estimate < dt {
             format!("{what} asks for simulation.dt ≤ {estimate:.3e} s")
+        } else if failure == Failure::Penetration {
+            format!(
+                "{what} ({estimate:.3e} s) is above the step, so the penetration may be \
+                 physical (a contact too soft for its load): if it is, raise \
+                 simulation.divergence.penetration_fraction or set max_penetration; \
+                 otherwise try simulation.dt = {:.3e} s",
+                dt / 4.0
+            )
         } else {
             format!(
                 "{what} ({estimate:.3e} s) is above the step, so the instability is \

@@ -63,6 +63,10 @@ fn penetration_beyond_the_limit_stops_the_run() {
         "{text}"
     );
     assert!(text.contains("beyond its limit of 12.5000 mm"), "{text}");
+    // RK4's stable step on this contact, 1.4 × 2/ω = 28 ms, is far above the
+    // 10 µs step: the message says the penetration may be physical.
+    assert!(text.contains("the penetration may be physical"), "{text}");
+    assert!(text.contains("2.800e-2 s"), "{text}");
     let t_cross = ((12.5e-3 - 9.81e-4) / 0.05f64).asin() / 100.0;
     assert!(
         (e.time - t_cross).abs() <= 1e-5,

@@ -371,7 +371,8 @@ impl Implicit {
 
     /// One SDIRK2 step of `h` seconds. A step whose Newton iterations do not
     /// converge is retried as two half steps, down to h/16; an error names
-    /// the stage that still did not converge (the state is then unchanged).
+    /// the stage that still did not converge (the state is then left at the
+    /// end of the last part step that did).
     pub(crate) fn sdirk2_step(
         &mut self,
         model: &Model,
@@ -479,6 +480,9 @@ impl Implicit {
         for k in 1..=settings.max_iterations {
             self.stats.newton_iterations += 1;
             self.set_stage(model, start, stage, s, t_stage, h);
+            // The divergence checks look at the last iterate only: Newton may
+            // overshoot deep into a contact on its way to the solution.
+            dynamics.watch.reset();
             if self.refresh || !self.factored || self.factored_gh != gh {
                 dynamics.forces_and_jacobian(model, stage, Mode::Trial, gh, &mut self.jac);
                 self.assemble_matrix(model, stage, gh);
