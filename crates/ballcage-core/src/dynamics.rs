@@ -92,30 +92,30 @@ pub struct Dynamics {
 
 /// What the contact points evaluated since the last
 /// [`ContactWatch::reset`] say about divergence and the stable step.
+///
+/// Each point is linearized (stiffness k = ∂F/∂δ, damping c = ∂F/∂δ̇ plus
+/// the friction slope, bounded by the trace of its Jacobian, m the pair's
+/// reduced mass); the watch keeps the largest ω² = k/m and ζω = c/2m, so
+/// that the per-point cost stays a few multiplications. The step estimates
+/// combine the two maxima, which is exact for one dominant contact and
+/// conservative otherwise.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ContactWatch {
     /// The deepest penetration relative to its pair's limit:
     /// (pair, depth [m], depth / limit).
     pub deepest: Option<(usize, f64, f64)>,
-    /// The smallest stable step of symplectic Euler over the points, from
-    /// the linearized contact (stiffness k = ∂F/∂δ, damping c = ∂F/∂δ̇ plus
-    /// the friction slope, the pair's reduced mass m):
-    /// h = 2 / (ζω + √(ζ²ω² + ω²)) with ω² = k/m, ζω = c/2m; with its pair.
-    pub explicit_step: (f64, usize),
-    /// The smallest 2/ω over the points (the elastic limit alone, which
-    /// binds an integrator implicit in the damping only); with its pair.
-    pub elastic_step: (f64, usize),
-    /// The shortest contact period 2π/ω over the points [s]; with its pair.
-    pub period: (f64, usize),
+    /// The largest ω² = k/m over the points [1/s²], with its pair.
+    pub stiffest: (f64, usize),
+    /// The largest ζω = c/2m over the points [1/s], with its pair.
+    pub dampest: (f64, usize),
 }
 
 impl Default for ContactWatch {
     fn default() -> Self {
         Self {
             deepest: None,
-            explicit_step: (f64::INFINITY, usize::MAX),
-            elastic_step: (f64::INFINITY, usize::MAX),
-            period: (f64::INFINITY, usize::MAX),
+            stiffest: (0.0, usize::MAX),
+            dampest: (0.0, usize::MAX),
         }
     }
 }
@@ -126,28 +126,53 @@ impl ContactWatch {
         *self = Self::default();
     }
 
+    /// Whether a loaded contact point was seen.
+    pub fn saw_contact(&self) -> bool {
+        self.stiffest.1 != usize::MAX || self.dampest.1 != usize::MAX
+    }
+
+    /// Symplectic Euler's stable step h = 2 / (ζω + √(ζ²ω² + ω²)) [s], and
+    /// the pair whose term dominates.
+    pub fn explicit_step(&self) -> (f64, usize) {
+        let (w2, a) = (self.stiffest.0, self.dampest.0);
+        let pair = if a * a > w2 {
+            self.dampest.1
+        } else {
+            self.stiffest.1
+        };
+        (2.0 / (a + (a * a + w2).sqrt()), pair)
+    }
+
+    /// The elastic limit 2/ω alone [s] (an integrator implicit in the
+    /// damping only), with its pair.
+    pub fn elastic_step(&self) -> (f64, usize) {
+        (2.0 / self.stiffest.0.sqrt(), self.stiffest.1)
+    }
+
+    /// The shortest contact period 2π/ω [s], with its pair.
+    pub fn period(&self) -> (f64, usize) {
+        (
+            std::f64::consts::TAU / self.stiffest.0.sqrt(),
+            self.stiffest.1,
+        )
+    }
+
     fn see(&mut self, k: usize, pair: &ContactPair, e: &ContactEval, d: &PointDerivatives) {
         let ratio = e.point.depth / pair.depth_limit;
         if ratio > self.deepest.map_or(0.0, |(_, _, r)| r) {
             self.deepest = Some((k, e.point.depth, ratio));
         }
-        let m = pair.reduced_mass;
-        if e.normal_force <= 0.0 || !m.is_finite() {
+        if e.normal_force <= 0.0 || !pair.reduced_mass.is_finite() {
             return;
         }
-        let omega = (d.d_depth.max(0.0) / m).sqrt();
-        let half_rate = (d.d_rate.max(0.0) + d.friction.norm()) / (2.0 * m);
-        let explicit = 2.0 / (half_rate + (half_rate * half_rate + omega * omega).sqrt());
-        if explicit < self.explicit_step.0 {
-            self.explicit_step = (explicit, k);
+        let inv = 1.0 / pair.reduced_mass;
+        let w2 = d.d_depth * inv;
+        if w2 > self.stiffest.0 {
+            self.stiffest = (w2, k);
         }
-        if omega > 0.0 {
-            if 2.0 / omega < self.elastic_step.0 {
-                self.elastic_step = (2.0 / omega, k);
-            }
-            if std::f64::consts::TAU / omega < self.period.0 {
-                self.period = (std::f64::consts::TAU / omega, k);
-            }
+        let half_rate = 0.5 * (d.d_rate.max(0.0) + d.friction.trace().abs()) * inv;
+        if half_rate > self.dampest.0 {
+            self.dampest = (half_rate, k);
         }
     }
 }

@@ -194,7 +194,7 @@ impl Simulation {
             self.recorder
                 .record(&self.model, &self.state, self.step, &mut self.dynamics);
         }
-        if self.dynamics.watch.explicit_step.0.is_finite() {
+        if self.dynamics.watch.saw_contact() {
             self.last_watch = self.dynamics.watch;
         }
         Ok(())
@@ -297,7 +297,7 @@ impl Simulation {
 
     /// What the stability estimate of the last accepted step says about dt.
     fn step_advice(&self, failure: Failure) -> String {
-        let w = if self.last_watch.explicit_step.0.is_finite() {
+        let w = if self.last_watch.saw_contact() {
             self.last_watch
         } else {
             self.dynamics.watch
@@ -305,14 +305,20 @@ impl Simulation {
         let kind = self.model.integrator;
         let dt = self.model.dt;
         let (estimate, pair) = match kind {
-            IntegratorKind::SymplecticEuler => w.explicit_step,
+            IntegratorKind::SymplecticEuler => w.explicit_step(),
             // RK4's stability interval on the real and imaginary axes is
             // about 2.8 against symplectic Euler's 2.
-            IntegratorKind::Rk4 => (1.4 * w.explicit_step.0, w.explicit_step.1),
-            IntegratorKind::LinearlyImplicitEuler => w.elastic_step,
+            IntegratorKind::Rk4 => {
+                let (h, pair) = w.explicit_step();
+                (1.4 * h, pair)
+            }
+            IntegratorKind::LinearlyImplicitEuler => w.elastic_step(),
             // No stability limit on the linearized contacts: resolve the
             // stiffest contact's period instead.
-            IntegratorKind::Sdirk2 => (w.period.0 / 10.0, w.period.1),
+            IntegratorKind::Sdirk2 => {
+                let (period, pair) = w.period();
+                (period / 10.0, pair)
+            }
         };
         let Some(p) = self.model.pairs.get(pair).filter(|_| estimate.is_finite()) else {
             return format!(
