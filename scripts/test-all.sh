@@ -6,12 +6,16 @@ cd "$(dirname "$0")/.."
 
 echo "== cargo fmt"
 cargo fmt --all -- --check
+echo "== function length (docs/architecture.md: none over 80 lines)"
+python3 scripts/long_functions.py 80
 echo "== cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
 echo "== cargo test"
 cargo test --workspace
 echo "== pip install .[test] (release build of the wheel)"
 python3 -m pip install --quiet ".[test]"
+echo "== stubtest (python/ballcage/_native.pyi against the built module)"
+python3 -m mypy.stubtest ballcage._native --mypy-config-file pyproject.toml
 echo "== pytest"
 # The package source lives in python/, so the root is not on the import path
 # as `ballcage`: pytest imports the installed wheel.

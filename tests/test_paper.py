@@ -21,7 +21,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import ballcage
-from ballcage import paper
+from ballcage import paper, studies
 
 REPO = Path(__file__).resolve().parent.parent
 #: The reference file of the project's shared folder (beside the repository in CI, or /work/shared).
@@ -69,7 +69,7 @@ def paper_out(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def short_run():
-    return ballcage.simulate(paper._paper_scene(SHORT), progress=False)
+    return ballcage.simulate(paper.paper_scene(SHORT), progress=False)
 
 
 def test_paper_writes_every_table_figure_and_comparison(paper_out):
@@ -201,14 +201,18 @@ def test_links_stay_inside_the_tube(short_run):
 
 
 def test_initial_chain_lies_on_the_centreline_chords(short_run):
-    # physics.md §7.5: a 200 mm pitch on R = 1.5 m gives included angles of 180 - 7.645 = 172.355 deg, and
+    # docs/model.md §7.5: a 200 mm pitch on R = 1.5 m gives included angles of 180 - 7.645 = 172.355 deg, and
     # each link's centre (a chord midpoint) sits one sagitta R - sqrt(R^2 - 0.1^2) inside the centreline.
     links = short_run.tables["links"]
     first = links.filter(pc.equal(links.column("step"), 0))
     angle = first.column("included_angle_deg").to_numpy()
     offset = first.column("radial_offset").to_numpy()
+    sagitta = 1.5 - math.sqrt(1.5**2 - 0.1**2)
     assert angle[:10] == pytest.approx(180.0 - 2.0 * math.degrees(math.asin(0.1 / 1.5)), abs=1e-3)
-    assert offset[:11] == pytest.approx(1.5 - math.sqrt(1.5**2 - 0.1**2), rel=1e-3)
+    assert offset[:11] == pytest.approx(sagitta, rel=1e-3)
+    # Inside the bend (toward the inner wall: negative outward) and in the bend plane.
+    assert first.column("offset_outward").to_numpy()[:11] == pytest.approx(-sagitta, rel=1e-3)
+    assert first.column("offset_lateral").to_numpy() == pytest.approx(0.0, abs=1e-9)
 
 
 def test_contact_forces_are_non_negative(short_run):
@@ -224,13 +228,54 @@ def test_contact_forces_are_non_negative(short_run):
 
 
 def test_shape_offsets_agree_with_the_native_radial_offset(short_run):
-    facts = paper._scene_facts(short_run)
+    # links.offset_outward (in the bend plane) and links.offset_lateral (out of it) resolve links.radial_offset.
     links = short_run.tables["links"]
-    com = np.stack([links.column(c).to_numpy() for c in ("com_x", "com_y", "com_z")], axis=-1)
-    radial, lateral = paper._centreline_offsets(facts, com)
-    assert np.hypot(radial, lateral) == pytest.approx(links.column("radial_offset").to_numpy(), abs=1e-9)
-    assert facts.rpm == pytest.approx(100.0)
-    assert [t for _, t in facts.phase_times()] == pytest.approx([0.01 - 0.45, 0.01 - 0.3, 0.01 - 0.15, 0.01])
+    outward = links.column("offset_outward").to_numpy()
+    lateral = links.column("offset_lateral").to_numpy()
+    assert np.hypot(outward, lateral) == pytest.approx(links.column("radial_offset").to_numpy(), abs=1e-9)
+
+
+def test_link_tube_forces_agree_with_the_summary_of_the_tube_pairs():
+    # A 3-joint pipe comes to rest on the tube from about 0.13 s. links.tube_normal / tube_tangential are the
+    # per-frame totals of each link's contact with the tube, so over the summary window their mean and peak are
+    # the summary's for that pair (the pair name is formatted here only to find its summary row).
+    start, end = 0.1, 0.2
+    scene = paper.paper_scene(
+        ["pipe.joints=3", f"simulation.duration={end}", "simulation.output_interval=0.005",
+         f"record.summary_window=[{start}, {end}]"]
+    )
+    run = ballcage.simulate(scene, progress=False)
+    summary = {r["pair"]: r for r in run.tables["summary"].to_pylist()}
+    links = run.tables["links"]
+    t = links.column("t").to_numpy()
+    inside = (t >= start - 1e-12) & (t <= end + 1e-12)
+    link = links.column("link").to_numpy()
+    normal = links.column("tube_normal").to_numpy()
+    tangential = links.column("tube_tangential").to_numpy()
+    assert normal[inside].max() > 100.0  # the chain rests on the tube [N]
+    assert (normal[~inside] == 0.0).any()  # and did not at the start
+    found = studies.quantities(run)
+    for k in (1, 2, 3):
+        row = summary[f"link{k:02d}/tube"]
+        mask = inside & (link == k)
+        assert mask.sum() == row["frames"], k
+        assert normal[mask].mean() == pytest.approx(row["normal_mean"], rel=1e-9), k
+        assert normal[mask].max() == pytest.approx(row["normal_peak"], rel=1e-9), k
+        assert tangential[mask].mean() == pytest.approx(row["tangential_mean"], rel=1e-9), k
+        assert found[f"tube_mean_force_joint_{k:02d}"].value == pytest.approx(row["normal_mean"], rel=1e-9), k
+    rows = {r["key"]: r for r in paper.comparison(run).to_pylist()}
+    for kind in ("normal", "tangential"):
+        total = sum(summary[f"link{k:02d}/tube"][f"{kind}_mean"] for k in (1, 2, 3))
+        assert rows[f"tube_{kind}_mean_all_n"]["ours"] == pytest.approx(total, rel=1e-9), kind
+    assert "not computed: the pipe has no link 10" in rows["tube_normal_mean_joint10_n"]["note"]
+
+
+def test_phases_are_the_quarter_turns_of_the_last_revolution(short_run):
+    # At 100 rpm a quarter turn takes 0.15 s: the phases fall at 0.01 - 0.45, - 0.3, - 0.15 and 0.01 s,
+    # so a 10 ms run holds only the last one (270°).
+    note = {r["key"]: r for r in paper.comparison(short_run).to_pylist()}["included_angle_min_deg"]["note"]
+    assert "270° t=0.010 s: link " in note
+    assert "1 of 4 phases in the run (0°, 90°, 180° fall before t = 0)" in note
 
 
 def test_run_paper_with_sweeps_fills_every_sweep_row(tmp_path):

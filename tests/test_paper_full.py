@@ -2,13 +2,13 @@
 stays in the tube, every key stays in its grooves and window, nothing is
 non-finite, and the drive balances the resisting moment on average.
 
-Limits are geometric (physics.md §3, §4), not numbers of an earlier run:
+Limits are geometric (docs/model.md §3, §4), not numbers of an earlier run:
 - a link centre may move off the tube centreline by the radial clearance,
   (116 − 86)/2 = 15 mm, plus its contact penetration (< 1 mm under the
   Adams law at the forces involved);
 - a key centre stays at ≈ PCR = 31.5 mm from its cage's axis: the bisector
   geometry moves it by ±c·sin(β/2) (0.52 mm at the 15° stop), flank clearance
-  and penetration add up to 0.6 mm at 33.5 kN (physics.md §5), the cage
+  and penetration add up to 0.6 mm at 33.5 kN (docs/model.md §5), the cage
   clearances 0.02 mm: 1.5 mm bounds all of that, while a key out of its
   Gothic-arch groove would have to climb its ~2 mm depth;
 - a key stays inside its 15.03 mm cage window: |axial offset| ≤ 7.515 mm − r_b

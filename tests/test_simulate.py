@@ -181,3 +181,13 @@ def test_public_api_is_curated():
     assert issubclass(ballcage.SceneError, ValueError)
     assert issubclass(ballcage.SimulationError, RuntimeError)
     assert isinstance(ballcage.__version__, str) and ballcage.__version__
+
+
+def test_run_scene_answers_for_the_scene_it_ran(free_fall):
+    run = ballcage.simulate(free_fall, progress=False)
+    assert run.scene.kind == "generic"
+    assert run.scene.value("simulation.dt") == pytest.approx(1e-3)
+    # A Run made from tables and TOML validates its scene once, on first use.
+    rebuilt = ballcage.Run(run.tables, run.scene_toml)
+    assert rebuilt.scene.to_toml() == run.scene_toml
+    assert rebuilt.scene is rebuilt.scene

@@ -13,15 +13,18 @@ __all__ = [
     "BUILD_PROFILE",
     "TABLE_NAMES",
     "INTEGRATORS",
+    "SCENE_KINDS",
     "SceneError",
     "SimulationError",
     "Scene",
     "Simulation",
     "default_scene_toml",
+    "integrator_facts",
     "table_schema",
+    "whole_multiple",
 ]
 
-TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"]
+_TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"]
 
 __version__: str
 #: Cargo profile the extension was built with; "debug" runs ~10x slower.
@@ -30,6 +33,8 @@ BUILD_PROFILE: Literal["release", "debug"]
 TABLE_NAMES: list[str]
 #: Every integrator name `simulation.integrator` accepts, explicit ones first.
 INTEGRATORS: list[str]
+#: Every scene kind (the `kind` key of a scene document).
+SCENE_KINDS: list[str]
 
 class SceneError(ValueError):
     """A scene that cannot be read or validated.
@@ -80,10 +85,39 @@ class Scene:
         """Interval between recorded frames [s]."""
 
     @property
-    def integrator(self) -> Literal["rk4", "symplectic-euler", "linearly-implicit-euler"]: ...
+    def integrator(self) -> Literal["symplectic-euler", "rk4", "linearly-implicit-euler", "sdirk2"]: ...
     @property
     def table_names(self) -> list[str]:
         """Tables the scene records, e.g. ``["bodies", "contacts"]``."""
+
+    @property
+    def kind(self) -> Literal["generic", "drill-pipe"]:
+        """The scene kind: a generic scene of bodies and pairs, or a drill pipe expanded into one."""
+
+    def value(self, key: str) -> Any:
+        """The resolved value at a dotted key of the scene document, e.g. ``"pipe.ball_keys.ball_mass"``.
+
+        Same keys as ``--set`` overrides (every default filled in); tables come
+        back as dicts, arrays as lists. Raises `SceneError` naming the key when
+        it does not exist.
+        """
+
+    def tightest_radius(self) -> float:
+        """The tightest guide-tube curvature radius [m] this drill pipe's hinge allows.
+
+        Whichever binds first of the articulation limit, R = p / (2 sin(β_max / 2)),
+        and the paper's eq. (9) for a rigid link in the tube. Raises `SceneError`
+        (path ``kind``) for a generic scene.
+        """
+
+    def centreline(self, count: int) -> dict[str, Any]:
+        """`count` points along the drill pipe's tube centreline, extended straight past the arc.
+
+        Keys ``"point"`` [m] and ``"tangent"`` (unit), world frame, and
+        ``"outward"`` (unit: in the bend plane, toward the outer wall of the
+        bend), each a list of ``[x, y, z]``; ``"s"`` [m] the arc length of each
+        point, a list of floats. Raises `SceneError` for a generic scene.
+        """
 
 @final
 class Simulation:
@@ -111,10 +145,23 @@ class Simulation:
     def finish(self) -> dict[str, pa.Table]:
         """One table per recorded table name. Callable once."""
 
-def table_schema(name: TableName | str) -> pa.Schema:
+def table_schema(name: _TableName | str) -> pa.Schema:
     """The Arrow schema of an output table; each field carries ``unit`` and ``description`` metadata.
 
     Raises `ValueError` for a name not in `TABLE_NAMES`.
+    """
+
+def integrator_facts() -> dict[str, dict[str, Any]]:
+    """Per integrator name: ``{"implicit": bool, "order": int, "description": str}``.
+
+    Implicit integrators solve a linear system per step; explicit ones must
+    resolve the stiffest contact's period.
+    """
+
+def whole_multiple(interval: float, step: float) -> int | None:
+    """``interval / step`` when it is a whole number ≥ 1 within the engine's tolerance, else ``None``.
+
+    The same test the scene validator applies to ``simulation.output_interval``.
     """
 
 def default_scene_toml() -> str:

@@ -22,11 +22,11 @@ import shlex
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
+from typing import NoReturn, TypeAlias
 
 from ballcage import _native
 from ballcage.run import simulate
-from ballcage.scene import SceneSource, default_scene, load_scene
+from ballcage.scene import default_scene, load_scene
 
 __all__ = ["main"]
 
@@ -94,7 +94,20 @@ def _build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog=PROG, description="Rigid-body contact dynamics with Arrow/Parquet output.")
     parser.add_argument("--version", action="version", version=f"{PROG} {_native.__version__}")
     commands = parser.add_subparsers(title="commands", required=True, metavar="COMMAND", parser_class=_Parser)
+    _add_run_command(commands)
+    _add_paper_command(commands)
+    _add_accuracy_command(commands)
+    _add_stability_command(commands)
+    _add_scene_command(commands)
+    _add_schema_command(commands)
+    return parser
 
+
+#: What `commands.add_parser` returns for each subcommand.
+_Commands: TypeAlias = "argparse._SubParsersAction[_Parser]"
+
+
+def _add_run_command(commands: _Commands) -> None:
     run = commands.add_parser(
         "run",
         help="simulate a scene and write Parquet tables",
@@ -106,11 +119,13 @@ def _build_parser() -> argparse.ArgumentParser:
         nargs="?",
         help="scene file (TOML); without it, the embedded paper scene (see `ballcage scene show`)",
     )
-    run.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_out_option(run)
     _add_set_option(run)
-    run.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    _add_quiet_option(run, "no progress bar and no summary")
     run.set_defaults(command=_run)
 
+
+def _add_paper_command(commands: _Commands) -> None:
     paper = commands.add_parser(
         "paper",
         help="run the paper's scene; write tables, the paper's figures and a comparison",
@@ -120,16 +135,18 @@ def _build_parser() -> argparse.ArgumentParser:
             "comparison.parquet / comparison.md against the paper's numbers. The full run takes minutes."
         ),
     )
-    paper.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_out_option(paper)
     _add_set_option(paper, example="--set simulation.duration=0.2 --set drive.speed_rpm=60")
     paper.add_argument(
         "--sweeps",
         action="store_true",
         help="also run the R = 1.0 / 2.5 m and 60 / 120 rpm variants (4 more runs) and fill the sweep rows",
     )
-    paper.add_argument("--quiet", "-q", action="store_true", help="no progress bar and no summary")
+    _add_quiet_option(paper, "no progress bar and no summary")
     paper.set_defaults(command=_paper)
 
+
+def _add_accuracy_command(commands: _Commands) -> None:
     accuracy = commands.add_parser(
         "accuracy",
         help="error against run time of each integrator over a ladder of steps (work-precision)",
@@ -148,7 +165,7 @@ def _build_parser() -> argparse.ArgumentParser:
         nargs="?",
         help="scene file (TOML); without it, the embedded paper scene (use --duration to keep it affordable)",
     )
-    accuracy.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_out_option(accuracy)
     _add_integrators_option(accuracy)
     accuracy.add_argument(
         "--steps",
@@ -161,11 +178,7 @@ def _build_parser() -> argparse.ArgumentParser:
             "explicit, 1-8x implicit)"
         ),
     )
-    accuracy.add_argument(
-        "--reference-integrator",
-        metavar="NAME",
-        help="integrator of the reference (default sdirk2 when the engine has it, else linearly-implicit-euler)",
-    )
+    accuracy.add_argument("--reference-integrator", metavar="NAME", help="integrator of the reference (default sdirk2)")
     accuracy.add_argument(
         "--reference-dt",
         metavar="DT",
@@ -173,9 +186,11 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     accuracy.add_argument("--duration", metavar="S", help="simulated duration [s] (default: the scene's)")
     _add_set_option(accuracy, example="--set pipe.joints=4 --set 'pipe.hinge=\"ideal-cv\"'")
-    accuracy.add_argument("--quiet", "-q", action="store_true", help="no progress lines and no summary")
+    _add_quiet_option(accuracy, "no progress lines and no summary")
     accuracy.set_defaults(command=_accuracy)
 
+
+def _add_stability_command(commands: _Commands) -> None:
     stability = commands.add_parser(
         "stability",
         help="largest stable step of each integrator against stiffness, speed, curvature, key mass, damping",
@@ -190,7 +205,7 @@ def _build_parser() -> argparse.ArgumentParser:
             "stability_<parameter>.png heat maps (integrator x value, colour log10 max stable dt) and stability.md."
         ),
     )
-    stability.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+    _add_out_option(stability)
     _add_integrators_option(stability)
     stability.add_argument(
         "--parameters",
@@ -212,9 +227,11 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     stability.add_argument("--grid", action="store_true", help="also map every stiffness x speed pair (stability_grid.png)")
     _add_set_option(stability, example="--set pipe.joints=3 --set 'pipe.hinge=\"ideal-cv\"'")
-    stability.add_argument("--quiet", "-q", action="store_true", help="no progress lines and no summary")
+    _add_quiet_option(stability, "no progress lines and no summary")
     stability.set_defaults(command=_stability)
 
+
+def _add_scene_command(commands: _Commands) -> None:
     scene = commands.add_parser(
         "scene",
         help="the embedded default scene",
@@ -228,6 +245,8 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     show.set_defaults(command=_scene_show)
 
+
+def _add_schema_command(commands: _Commands) -> None:
     schema = commands.add_parser(
         "schema",
         help="print the columns of the output tables",
@@ -235,7 +254,14 @@ def _build_parser() -> argparse.ArgumentParser:
     )
     schema.add_argument("table", nargs="?", choices=TABLE_NAMES, metavar="TABLE", help=f"one of {', '.join(TABLE_NAMES)}")
     schema.set_defaults(command=_schema)
-    return parser
+
+
+def _add_out_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
+
+
+def _add_quiet_option(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument("--quiet", "-q", action="store_true", help=what)
 
 
 def _add_set_option(parser: argparse.ArgumentParser, example: str | None = None) -> None:
@@ -272,17 +298,16 @@ def _checked_out(out: Path) -> Path:
 
 def _load_cli_scene(arg: str | None, overrides: Sequence[str]) -> _native.Scene:
     """The scene named on the command line (or the embedded one) with `overrides`; bad input is a `UsageError`."""
-    source = _scene_source(arg)
     try:
-        if source is None:
+        if arg is None:
             return default_scene(overrides)
-        return load_scene(source, overrides)
+        return load_scene(arg, overrides)
     except _native.SceneError as e:
-        raise UsageError(f"{source or DEFAULT_SCENE_NAME}: {e}") from e
+        raise UsageError(f"{arg or DEFAULT_SCENE_NAME}: {e}") from e
     except OSError as e:  # missing, a directory, unreadable
-        raise UsageError(f"{e.strerror or e}: {e.filename or source}") from e
+        raise UsageError(f"{e.strerror or e}: {e.filename or arg}") from e
     except UnicodeDecodeError as e:
-        raise UsageError(f"{source}: not UTF-8 text ({e.reason} at byte {e.start})") from e
+        raise UsageError(f"{arg}: not UTF-8 text ({e.reason} at byte {e.start})") from e
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -305,11 +330,6 @@ def _run(args: argparse.Namespace) -> int:
         for name, path in paths.items():
             print(_summary(name, path, result.tables.get(name)))
     return 0
-
-
-def _scene_source(arg: str | None) -> SceneSource | None:
-    """The scene named on the command line; ``None`` for the embedded default scene."""
-    return arg
 
 
 def _positive(option: str, text: str | None, what: str = "a positive time in seconds") -> float | None:

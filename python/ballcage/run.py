@@ -9,7 +9,6 @@ steps are the same).
 from __future__ import annotations
 
 import os
-import secrets
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping
@@ -17,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from ballcage import _native
+from ballcage._files import write_atomically
 from ballcage.scene import SceneSource, load_scene
 
 if TYPE_CHECKING:
@@ -37,9 +37,17 @@ class Run:
     ``"energy"``) to a `pyarrow.Table`; units are in each field's metadata.
     """
 
-    def __init__(self, tables: Mapping[str, pa.Table], scene_toml: str, *, error: str | None = None) -> None:
+    def __init__(
+        self,
+        tables: Mapping[str, pa.Table],
+        scene_toml: str,
+        *,
+        error: str | None = None,
+        scene: _native.Scene | None = None,
+    ) -> None:
         self.tables: dict[str, pa.Table] = dict(tables)
         self._scene_toml = scene_toml
+        self._scene = scene
         #: Why the run stopped early (the `SimulationError` message); ``None`` for a complete run.
         self.error: str | None = error
 
@@ -78,6 +86,17 @@ class Run:
         """The resolved scene as TOML, every default written out."""
         return self._scene_toml
 
+    @property
+    def scene(self) -> _native.Scene:
+        """The run's scene, to ask for its values (``run.scene.value("drive.speed_rpm")``).
+
+        The scene `simulate` ran; for a `Run` built from tables and TOML,
+        `scene_toml` validated once on first use.
+        """
+        if self._scene is None:
+            self._scene = _native.Scene.from_toml(self._scene_toml)
+        return self._scene
+
     def write(self, directory: str | os.PathLike[str]) -> dict[str, Path]:
         """Writes ``<table>.parquet`` (zstd) for every table and ``scene.toml`` into `directory`.
 
@@ -97,10 +116,10 @@ class Run:
             def write_parquet(tmp: Path, table: pa.Table = table) -> None:
                 pq.write_table(table, str(tmp), compression="zstd")
 
-            _write_atomically(path, write_parquet)
+            write_atomically(path, write_parquet)
             written[name] = path
         scene_path = out / "scene.toml"
-        _write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
+        write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
         written["scene"] = scene_path
         return written
 
@@ -149,11 +168,11 @@ def simulate(
     except _native.SimulationError as e:
         # The native Simulation stays usable after an error: hand over what it
         # recorded (its metadata has ballcage.complete = "false" and ballcage.error).
-        e.run = Run(sim.finish(), resolved.to_toml(), error=str(e))  # type: ignore[attr-defined]
+        e.run = Run(sim.finish(), resolved.to_toml(), error=str(e), scene=resolved)  # type: ignore[attr-defined]
         raise
     finally:
         bar.close()
-    return Run(sim.finish(), resolved.to_toml())
+    return Run(sim.finish(), resolved.to_toml(), scene=resolved)
 
 
 class _ProgressBar:
@@ -218,42 +237,3 @@ def _isatty(stream: TextIO) -> bool:
         return stream.isatty()
     except (AttributeError, ValueError):
         return False
-
-
-def _write_atomically(final: Path, write: Callable[[Path], object]) -> None:
-    """Writes `final` through a hidden temporary file in the same directory.
-
-    `write(tmp)` fills the temporary file; it is then fsynced and renamed over
-    `final` (``os.replace``, atomic on POSIX and Windows). On any exception the
-    temporary file is removed and `final` is left as it was.
-    """
-    tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
-    # O_EXCL: never clobber another writer's temporary; mode 0o666 minus umask,
-    # the permissions a plain open() would give the final file.
-    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
-    try:
-        write(tmp)
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-        os.replace(tmp, final)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    _fsync_directory(final.parent)
-
-
-def _fsync_directory(directory: Path) -> None:
-    """Makes a rename durable; a no-op where directories cannot be opened (Windows)."""
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)

@@ -1,6 +1,6 @@
 //! Whole-simulation benchmarks: integrator steps of small scenes.
 
-use ballcage_core::{Scene, Simulation};
+use ballcage_core::{Document, Scene, Simulation};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 const BALLS_ON_PLANE: &str = r#"
@@ -37,7 +37,7 @@ fn paper(c: &mut Criterion) {
     let mut g = c.benchmark_group("paper scene, first 5 ms");
     g.sample_size(10);
     for (integrator, dt) in [("linearly-implicit-euler", 1e-5), ("sdirk2", 1e-4)] {
-        let s = Scene::from_toml_str(
+        let s = Document::from_toml_str(
             "kind = \"drill-pipe\"\n",
             &[
                 format!("simulation.integrator=\"{integrator}\""),
@@ -49,7 +49,7 @@ fn paper(c: &mut Criterion) {
         .expect("valid paper scene");
         g.bench_function(format!("{integrator} at {dt} s"), |b| {
             b.iter(|| {
-                let mut sim = Simulation::new(&s).expect("assembles");
+                let mut sim = s.simulation();
                 sim.run().expect("stable");
                 sim.steps()
             })

@@ -1,7 +1,6 @@
 //! Runs the paper scene for a short time and prints stability and cost figures.
 //! Usage: cargo run --release --example probe -- DT INTEGRATOR DURATION
-use ballcage_core::Scene;
-use ballcage_core::Simulation;
+use ballcage_core::Document;
 use std::time::Instant;
 
 fn main() {
@@ -19,14 +18,15 @@ fn main() {
     ];
     let mut all = overrides.clone();
     all.extend(args.iter().skip(4).cloned());
-    let scene =
-        Scene::from_toml_str("kind = \"drill-pipe\"\n", &all).unwrap_or_else(|e| panic!("{e}"));
+    let doc =
+        Document::from_toml_str("kind = \"drill-pipe\"\n", &all).unwrap_or_else(|e| panic!("{e}"));
+    let scene = doc.scene();
     println!(
         "bodies {} contacts {}",
         scene.bodies.len(),
         scene.contacts.len()
     );
-    let mut sim = Simulation::new(&scene).unwrap();
+    let mut sim = doc.simulation();
     let t0 = Instant::now();
     let dur: f64 = dur.parse().unwrap();
     let mut k = 0;

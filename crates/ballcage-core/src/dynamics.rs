@@ -9,7 +9,7 @@
 //!    for `spin` bodies.
 
 use crate::force::friction_force;
-use crate::force::joint::twist_axis;
+use crate::force::joint::{bend, twist_axis};
 use crate::geometry::ContactPoint;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
@@ -56,6 +56,40 @@ pub struct ContactEval {
     pub tangential_force: Vec3,
     /// Slip speed |v_t| [m/s].
     pub slip_speed: f64,
+}
+
+impl ContactEval {
+    /// The point's contact force on body b [N], world frame: F_n·n + F_t
+    /// (body a takes the opposite).
+    #[inline]
+    pub fn force(&self) -> Vec3 {
+        self.point.normal * self.normal_force + self.tangential_force
+    }
+}
+
+/// Torque of all contact forces on `body` about its centre of mass [N·m],
+/// world frame, from the points `evals[k]` of every pair k evaluated at
+/// `state` (e.g. by [`Dynamics::contact_points`]).
+pub fn contact_torque(
+    model: &Model,
+    state: &State,
+    evals: &[Vec<ContactEval>],
+    body: usize,
+) -> Vec3 {
+    let mut tau = Vec3::zeros();
+    for (pair, ev) in model.pairs.iter().zip(evals) {
+        let sign = if pair.b == body {
+            1.0
+        } else if pair.a == body {
+            -1.0
+        } else {
+            continue;
+        };
+        for e in ev {
+            tau += sign * (e.point.point - state.pos[body]).cross(&e.force());
+        }
+    }
+    tau
 }
 
 /// Energy of the system at one instant [J].
@@ -269,43 +303,41 @@ impl Dynamics {
         }
         // 3. contacts
         for k in 0..model.pairs.len() {
-            let pair = &model.pairs[k];
-            let mut points = std::mem::take(&mut self.points);
-            find_points(model, pair, state, &mut points);
-            let latched = &mut self.latched[k];
-            if mode == Mode::Commit && !latched.is_empty() {
-                let mut seen = [false; 64];
-                for p in &points {
-                    let rate = depth_rate(state, pair, p);
-                    let slot = p.slot as usize;
-                    if latched[slot].is_none() {
-                        latched[slot] = Some(rate);
-                    }
-                    if slot < seen.len() {
-                        seen[slot] = true;
-                    }
-                }
-                for (s, l) in latched.iter_mut().enumerate() {
-                    if s < seen.len() && !seen[s] {
-                        *l = None;
-                    }
-                }
-            }
-            for p in &points {
-                let (e, d) = evaluate_point_full(state, pair, p, &self.latched[k]);
-                self.watch.see(k, pair, &e, &d);
-                let f = e.point.normal * e.normal_force + e.tangential_force;
-                let (a, b) = (pair.a, pair.b);
-                self.force[b] += f;
-                self.torque[b] += (p.point - state.pos[b]).cross(&f);
-                self.force[a] -= f;
-                self.torque[a] -= (p.point - state.pos[a]).cross(&f);
-                if let Some(jac) = jac.as_deref_mut() {
-                    jac.add_contact_point(k, state, pair, &e, &d);
-                }
-            }
-            self.points = points;
+            self.contacts(model, state, mode, k, jac.as_deref_mut());
         }
+    }
+
+    /// Stage 3 for pair `k`: finds its points, latches onsets in
+    /// [`Mode::Commit`], evaluates the laws and adds the forces (and, with
+    /// `jac`, their Jacobian).
+    fn contacts(
+        &mut self,
+        model: &Model,
+        state: &State,
+        mode: Mode,
+        k: usize,
+        mut jac: Option<&mut VelocityJacobian>,
+    ) {
+        let pair = &model.pairs[k];
+        let mut points = std::mem::take(&mut self.points);
+        find_points(model, pair, state, &mut points);
+        if mode == Mode::Commit {
+            latch(&mut self.latched[k], state, pair, &points);
+        }
+        for p in &points {
+            let (e, d) = evaluate_point_full(state, pair, p, &self.latched[k]);
+            self.watch.see(k, pair, &e, &d);
+            let f = e.force();
+            let (a, b) = (pair.a, pair.b);
+            self.force[b] += f;
+            self.torque[b] += (p.point - state.pos[b]).cross(&f);
+            self.force[a] -= f;
+            self.torque[a] -= (p.point - state.pos[a]).cross(&f);
+            if let Some(jac) = jac.as_deref_mut() {
+                jac.add_contact_point(k, state, pair, &e, &d);
+            }
+        }
+        self.points = points;
     }
 
     /// Whether some pair keeps per-contact memory (latched approach speeds),
@@ -411,6 +443,31 @@ impl Dynamics {
             kinetic,
             potential_gravity,
             potential_contact,
+        }
+    }
+}
+
+/// Latches the approach speed of every point of `points` that has none
+/// (a contact onset) and forgets those of slots not in contact; `latched`
+/// is empty for laws that do not latch.
+fn latch(latched: &mut [Option<f64>], state: &State, pair: &ContactPair, points: &[ContactPoint]) {
+    if latched.is_empty() {
+        return;
+    }
+    let mut seen = [false; 64];
+    for p in points {
+        let rate = depth_rate(state, pair, p);
+        let slot = p.slot as usize;
+        if latched[slot].is_none() {
+            latched[slot] = Some(rate);
+        }
+        if slot < seen.len() {
+            seen[slot] = true;
+        }
+    }
+    for (s, l) in latched.iter_mut().enumerate() {
+        if s < seen.len() && !seen[s] {
+            *l = None;
         }
     }
 }
@@ -656,11 +713,9 @@ impl VelocityJacobian {
             rotational += twist * axis * axis.transpose();
         }
         if s > 0.0 && p.stop_stiffness != 0.0 {
-            let (ea, eb) = (state.rot[j.a] * Vec3::x(), state.rot[j.b] * Vec3::x());
-            let cross = ea.cross(&eb);
-            let bend = cross.norm().atan2(ea.dot(&eb));
+            let (bend, opening) = bend(&state.rot[j.a], &state.rot[j.b]);
             if bend > p.bend_limit
-                && let Some(u) = cross.try_normalize(1e-12)
+                && let Some(u) = opening
             {
                 rotational += s * p.stop_stiffness * u * u.transpose();
             }

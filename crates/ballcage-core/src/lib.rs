@@ -12,8 +12,13 @@
 //! channels in columnar buffers, which [`output`] turns into Arrow tables with
 //! the one schema of the project.
 //!
-//! Units are SI throughout; the paper's field units are converted on reading
-//! the scene (see [`scene::FieldUnits`]).
+//! Units are SI throughout; the paper's field units ([`scene::FieldUnits`])
+//! are converted once, at assembly ([`assembly::normal_law`]).
+//!
+//! The drill pipe ([`drillpipe`]) is a layer above the engine: it expands
+//! its document into a generic scene and adds its tables through a
+//! [`record::Observer`]. [`loader`] reads a document of either kind. See
+//! docs/architecture.md for the map of the stages and what each may import.
 
 pub mod assembly;
 pub mod drillpipe;
@@ -22,6 +27,7 @@ pub mod error;
 pub mod force;
 pub mod geometry;
 pub mod integrate;
+pub mod loader;
 pub mod math;
 pub mod model;
 #[cfg(feature = "arrow")]
@@ -31,6 +37,7 @@ pub mod scene;
 pub mod sim;
 
 pub use error::{SceneError, SimulationError};
+pub use loader::Document;
 pub use model::{Model, State};
 pub use scene::Scene;
 pub use sim::Simulation;

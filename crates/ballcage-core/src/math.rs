@@ -54,3 +54,10 @@ pub fn dexp_inv(xi: &Vec3, w: &Vec3) -> Vec3 {
     let xw = xi.cross(w);
     w + 0.5 * xw + c * xi.cross(&xw)
 }
+
+/// Angle between two vectors [rad], in [0, π]: atan2(|a × b|, a · b), accurate
+/// near 0 and π where acos is not. The one bend-angle formula of the engine.
+#[inline]
+pub fn angle_between(a: &Vec3, b: &Vec3) -> Real {
+    a.cross(b).norm().atan2(a.dot(b))
+}

@@ -240,8 +240,6 @@ pub struct Model {
     pub record: RecordPlan,
     /// Scene name.
     pub name: String,
-    /// Where the drill pipe's parts are, for drill-pipe scenes.
-    pub drill_pipe: Option<crate::drillpipe::Layout>,
 }
 
 impl Model {

@@ -8,7 +8,7 @@ use crate::error::{SceneError, SimulationError};
 use crate::integrate::{self, Stats, Workspace};
 use crate::math::Vec3;
 use crate::model::{Model, Motion, State};
-use crate::record::{Recorder, Recording};
+use crate::record::{Observer, Recorder, Recording};
 use crate::scene::{IntegratorKind, Scene};
 
 /// A simulation of one scene.
@@ -58,12 +58,26 @@ struct EnergyBalance {
 }
 
 impl Simulation {
-    /// Validates and assembles `scene`, and records the frame at t = 0.
+    /// Assembles a generic `scene` and records the frame at t = 0. Scene
+    /// documents of any kind start simulations through the loader's
+    /// `Document::simulation`, a layer above, with their observers.
     pub fn new(scene: &Scene) -> Result<Self, SceneError> {
         let (model, state) = assemble(scene)?;
+        Ok(Self::from_model(model, state, vec![], scene.to_toml()))
+    }
+
+    /// A simulation of an assembled model from `state`, with `observers`
+    /// filling tables of their own; `scene_toml` goes into the output
+    /// metadata. Records the frame at `state`.
+    pub fn from_model(
+        model: Model,
+        state: State,
+        observers: Vec<Box<dyn Observer>>,
+        scene_toml: String,
+    ) -> Self {
         let mut dynamics = Dynamics::new(&model);
         let workspace = Workspace::new(&state);
-        let mut recorder = Recorder::new(&model);
+        let mut recorder = Recorder::new(&model, observers);
         recorder.record(&model, &state, 0, &mut dynamics);
         let e0 = dynamics.energy(&model, &state);
         let balance = EnergyBalance {
@@ -72,19 +86,19 @@ impl Simulation {
             initial_free: e0.kinetic + e0.potential_contact,
             ..EnergyBalance::default()
         };
-        Ok(Self {
+        Self {
             model,
             state,
             dynamics,
             workspace,
             recorder,
-            scene_toml: scene.to_toml(),
+            scene_toml,
             step: 0,
             wall: Duration::ZERO,
             failed: None,
             balance,
             last_watch: ContactWatch::default(),
-        })
+        }
     }
 
     /// The assembled model.
@@ -169,17 +183,15 @@ impl Simulation {
         let h = self.model.dt;
         self.dynamics.watch.reset();
         if let Err(reason) = integrate::step(
-            self.model.integrator,
             &self.model,
             &mut self.dynamics,
             &mut self.workspace,
             &mut self.state,
-            h,
+            self.step,
         ) {
             return self.fail(reason);
         }
         self.step += 1;
-        self.state.t = self.step as f64 * h;
         if let Some(reason) = self.non_finite() {
             return self.fail(reason);
         }

@@ -1,9 +1,9 @@
-//! The drill pipe's parts against hand calculations (physics.md §7.5, §7.6, §7.9).
+//! The drill pipe's parts against hand calculations (docs/model.md §7.4, §7.5, §7.6, §7.9).
 
 mod common;
 
 use ballcage_core::force::joint::twist_angle;
-use ballcage_core::{Scene, Simulation};
+use ballcage_core::{Document, Simulation};
 
 const K_SI: f64 = 1e5 * 3.981_071_705_534_972e6; // 1e5 N/mm^2.2 in N/m^2.2 (1000^2.2 = 10^6.6)
 
@@ -49,7 +49,7 @@ fn resting_link(points: u32) -> (f64, f64, f64) {
 
 #[test]
 fn a_link_resting_in_a_horizontal_tube_carries_its_weight() {
-    // physics.md §7.6: Σ F_n = m g = 78.50 N whatever the sampling; δ = (m g / (N K))^(1/2.2).
+    // docs/model.md §7.6: Σ F_n = m g = 78.50 N whatever the sampling; δ = (m g / (N K))^(1/2.2).
     let mg = 8.010 * 9.8;
     for points in [2, 5, 9] {
         let (total, depth, speed) = resting_link(points);
@@ -75,12 +75,13 @@ fn a_link_resting_in_a_horizontal_tube_carries_its_weight() {
 
 #[test]
 fn the_paper_scene_expands_to_its_bodies_and_pairs_and_starts_without_contact() {
-    let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &[]).unwrap();
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &[]).unwrap();
+    let scene = doc.scene();
     // 1 tube + 2 connectors + 12 links + 13 cages + 78 keys.
     assert_eq!(scene.bodies.len(), 106);
     // 12 link–tube pairs; per hinge 2 cage spheres + 6 keys × (2 + 2 flanks + 2 window pairs).
     assert_eq!(scene.contacts.len(), 12 + 13 * (2 + 6 * 6));
-    let mut sim = Simulation::new(&scene).unwrap();
+    let mut sim = doc.simulation();
     for k in 0..scene.contacts.len() {
         assert!(
             sim.pair_contacts(k).is_empty(),
@@ -90,22 +91,22 @@ fn the_paper_scene_expands_to_its_bodies_and_pairs_and_starts_without_contact() 
     }
     // The default is the paper's: printing and reading back gives the same scene,
     // and what is printed is the short drill-pipe form, not the expansion.
-    let text = scene.to_toml();
+    let text = doc.to_toml();
     assert!(
         text.starts_with("kind = \"drill-pipe\""),
         "{}",
         &text[..200.min(text.len())]
     );
     assert!(text.len() < 10_000, "{} bytes", text.len());
-    let again = Scene::from_toml_str(&text, &[]).unwrap();
-    assert_eq!(again.bodies, scene.bodies);
-    assert_eq!(again.contacts, scene.contacts);
+    let again = Document::from_toml_str(&text, &[]).unwrap();
+    assert_eq!(again.scene().bodies, scene.bodies);
+    assert_eq!(again.scene().contacts, scene.contacts);
 }
 
 #[test]
 fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
     let o = |s: &[&str]| s.iter().map(|x| x.to_string()).collect::<Vec<_>>();
-    let scene = Scene::from_toml_str(
+    let doc = Document::from_toml_str(
         "kind = \"drill-pipe\"\n",
         &o(&[
             "pipe.joints=4",
@@ -115,6 +116,7 @@ fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
         ]),
     )
     .unwrap();
+    let scene = doc.scene();
     assert_eq!(
         scene
             .bodies
@@ -123,16 +125,16 @@ fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
             .count(),
         4
     );
-    let spec = scene.origin.as_ref().unwrap();
+    let (spec, _) = doc.drill_pipe_parts().unwrap();
     assert_eq!(spec.borehole.curvature_radius, 2.5);
     let upper = scene.bodies.iter().find(|b| b.name == "upper").unwrap();
     assert!(
         (upper.spin_speed - 2.0 * std::f64::consts::PI).abs() < 1e-12,
         "60 rpm = 2π rad/s"
     );
-    let e = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o(&["pipe.joints=0"])).unwrap_err();
+    let e = Document::from_toml_str("kind = \"drill-pipe\"\n", &o(&["pipe.joints=0"])).unwrap_err();
     assert_eq!(e.path, "pipe.joints");
-    let e = Scene::from_toml_str(
+    let e = Document::from_toml_str(
         "kind = \"drill-pipe\"\n",
         &o(&["borehole.curvature_radius=-1"]),
     )
@@ -140,14 +142,14 @@ fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
     assert_eq!(e.path, "borehole.curvature_radius");
 }
 
-/// Section model of one loaded key (physics.md §3 geometry): the loaded head
+/// Section model of one loaded key (docs/model.md §3 geometry): the loaded head
 /// flank centre sits at +a(cos α, sin α) and the seat flank centre at
 /// −a(cos α, sin α) from the ball (radial, circumferential), a = ρ_g − r_b − s.
 /// Turning the seat by u = PCR·θ moves its flank centre by u around; the ball,
 /// pressed equally by both, lies midway, each contact penetrating δ with
 /// |C_head − C_seat| = 2(a + s + δ). So cos α′ = a·cos α/(a + s + δ) and
 /// T = 6·K·δⁿ·PCR·sin α′. Returns (per-key force [N], wind-up per hinge [rad]).
-/// With s = 0 and δ ≪ a this is physics.md §7.9: T/(6·PCR·sin 45°) = 13.47 kN.
+/// With s = 0 and δ ≪ a this is docs/model.md §7.9: T/(6·PCR·sin 45°) = 13.47 kN.
 fn section_model(torque: f64, k: f64, n: f64, s: f64) -> (f64, f64) {
     let (pcr, alpha, rho_g, r_b) = (0.0315, std::f64::consts::FRAC_PI_4, 0.0078, 0.0075);
     let a = rho_g - r_b - s;
@@ -188,8 +190,9 @@ fn quasi_static_hinges(extra: &[&str]) -> (Vec<(f64, f64)>, f64) {
     .map(|s| s.to_string())
     .collect();
     o.extend(extra.iter().map(|s| s.to_string()));
-    let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
-    let mut sim = Simulation::new(&scene).unwrap();
+    let mut sim = Document::from_toml_str("kind = \"drill-pipe\"\n", &o)
+        .unwrap()
+        .simulation();
     let lower = common::body(&sim, "lower");
     let q0 = sim.state().rot[lower];
     sim.run().unwrap();
@@ -219,7 +222,7 @@ fn quasi_static_hinges(extra: &[&str]) -> (Vec<(f64, f64)>, f64) {
 
 #[test]
 fn one_hinge_under_quasi_static_torque_carries_13_47_kn_per_key() {
-    // physics.md §7.9's assumptions: no flank clearance, contacts stiff enough
+    // docs/model.md §7.9's assumptions: no flank clearance, contacts stiff enough
     // that the 45° contact angle holds (K = 1e12 N/mm^2.2: δ ≈ 0.3 µm ≪ a = 0.3 mm).
     let (forces, _) = quasi_static_hinges(&[
         "pipe.ball_keys.flank_clearance=0",
@@ -276,7 +279,7 @@ fn with_the_paper_law_the_contact_angle_opens_and_keys_carry_less() {
 
 #[test]
 fn a_ball_key_hinge_passes_spin_at_constant_velocity() {
-    // physics.md §7.4: full contact model, light load, β = 7.6°: |ω_out/ω_in − 1| < 1e-3
+    // docs/model.md §7.4: full contact model, light load, β = 7.6°: |ω_out/ω_in − 1| < 1e-3
     // (a Cardan joint at 7.645° would swing between 0.99111 and 1.00897).
     // One link on R = 0.75 m: both hinges bend 2·asin(0.1/0.75)/2 = 7.66°.
     let o: Vec<String> = [
@@ -296,8 +299,9 @@ fn a_ball_key_hinge_passes_spin_at_constant_velocity() {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
-    let mut sim = Simulation::new(&scene).unwrap();
+    let mut sim = Document::from_toml_str("kind = \"drill-pipe\"\n", &o)
+        .unwrap()
+        .simulation();
     let (upper, link) = (common::body(&sim, "upper"), common::body(&sim, "link01"));
     let bend = {
         let s = sim.state();
@@ -332,8 +336,8 @@ fn a_ball_key_hinge_passes_spin_at_constant_velocity() {
 }
 
 /// Included angles [deg] between adjacent bodies of the chain (upper, links, lower).
-fn included_angles(sim: &Simulation) -> Vec<f64> {
-    let chain = &sim.model().drill_pipe.as_ref().expect("a drill pipe").chain;
+fn included_angles(doc: &Document, sim: &Simulation) -> Vec<f64> {
+    let chain = &doc.drill_pipe_parts().expect("a drill pipe").1.chain;
     let s = sim.state();
     chain
         .windows(2)
@@ -362,12 +366,12 @@ fn ideal_cv_and_ball_keys_agree_on_the_included_angles() {
             "record.tables=[]".into(),
         ]
         .to_vec();
-        let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
-        let mut sim = Simulation::new(&scene).unwrap();
-        let mut frames = vec![included_angles(&sim)];
+        let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+        let mut sim = doc.simulation();
+        let mut frames = vec![included_angles(&doc, &sim)];
         while !sim.is_done() {
             sim.advance_to(sim.time() + 0.005).unwrap();
-            frames.push(included_angles(&sim));
+            frames.push(included_angles(&doc, &sim));
         }
         frames
     };
@@ -387,21 +391,13 @@ fn ideal_cv_and_ball_keys_agree_on_the_included_angles() {
 }
 
 /// Last value of column `name` of the recorded table `table`.
-fn last_value(
-    rec: &ballcage_core::record::Recording,
-    table: ballcage_core::scene::TableKind,
-    name: &str,
-) -> f64 {
+fn last_value(rec: &ballcage_core::record::Recording, table: &str, name: &str) -> f64 {
     let t = rec
         .tables
         .iter()
-        .find(|t| t.kind == table)
+        .find(|t| t.def.name == table)
         .expect("table recorded");
-    let col = ballcage_core::record::columns(table)
-        .iter()
-        .position(|c| c.name == name)
-        .expect("column");
-    match &t.data[col] {
+    match t.column(name).expect("column") {
         ballcage_core::record::ColumnData::F64(v) => *v.last().expect("rows"),
         other => panic!("{name} is not a float column: {other:?}"),
     }
@@ -426,16 +422,12 @@ fn at_rest_the_drive_holds_exactly_the_resisting_moment() {
             "record.tables=[\"drive\"]".into(),
         ]
         .to_vec();
-        let scene = Scene::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
-        let mut sim = Simulation::new(&scene).unwrap();
+        let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+        let mut sim = doc.simulation();
         sim.run().unwrap();
         let rec = sim.finish();
-        let input = last_value(&rec, ballcage_core::scene::TableKind::Drive, "input_torque");
-        let output = last_value(
-            &rec,
-            ballcage_core::scene::TableKind::Drive,
-            "output_torque",
-        );
+        let input = last_value(&rec, "drive", "input_torque");
+        let output = last_value(&rec, "drive", "output_torque");
         assert!(
             (output - 1800.0).abs() < 1e-9,
             "{hinge}: output torque {output}"
@@ -445,4 +437,112 @@ fn at_rest_the_drive_holds_exactly_the_resisting_moment() {
             "{hinge}: input torque {input} N·m"
         );
     }
+}
+
+/// Float column `name` of the recorded table `table`.
+fn float_column<'a>(
+    rec: &'a ballcage_core::record::Recording,
+    table: &str,
+    name: &str,
+) -> &'a [f64] {
+    let t = rec
+        .tables
+        .iter()
+        .find(|t| t.def.name == table)
+        .expect("table recorded");
+    match t.column(name).expect("column") {
+        ballcage_core::record::ColumnData::F64(v) => v,
+        other => panic!("{name} is not a float column: {other:?}"),
+    }
+}
+
+#[test]
+fn links_placed_on_chords_sit_one_sagitta_inside_the_arc() {
+    // Option A placement: hinges on the centreline, links on the chords. A
+    // chord of length p on a circle of radius R has its midpoint the sagitta
+    // s = R − √(R² − (p/2)²) inside the circle: toward the inner wall, in the
+    // bend plane. R = 1.5 m, p = 0.2 m: s = 3.337 mm. Hinges 0–11 lie on the
+    // arc, so links 1–11 are chords of it.
+    let o: Vec<String> = ["simulation.duration=1e-4", "record.tables=[\"links\"]"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+    let rec = doc.simulation().finish();
+    let sagitta = 1.5 - (1.5_f64.powi(2) - 0.1_f64.powi(2)).sqrt();
+    let outward = float_column(&rec, "links", "offset_outward");
+    let lateral = float_column(&rec, "links", "offset_lateral");
+    let distance = float_column(&rec, "links", "radial_offset");
+    for k in 0..11 {
+        assert!(
+            (outward[k] + sagitta).abs() < 1e-9,
+            "link {}: outward offset {} m, expected −{sagitta} m",
+            k + 1,
+            outward[k]
+        );
+        assert!(
+            lateral[k].abs() < 1e-12,
+            "link {}: lateral {}",
+            k + 1,
+            lateral[k]
+        );
+        assert!((distance[k] - sagitta).abs() < 1e-9, "link {}", k + 1);
+    }
+}
+
+#[test]
+fn link_tube_forces_are_the_sums_of_each_links_contact_rows() {
+    // The links table finds each link's tube contact by the pair id the
+    // expansion recorded; its per-frame total must equal the sum of the
+    // contacts rows between the tube (body 0) and that link's body.
+    let o: Vec<String> = [
+        "pipe.hinge=\"ideal-cv\"",
+        "simulation.duration=0.3",
+        "record.tables=[\"links\", \"contacts\"]",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+    let mut sim = doc.simulation();
+    sim.run().unwrap();
+    let rec = sim.finish();
+    let u32s = |table: &str, name: &str| -> Vec<u32> {
+        let t = rec.tables.iter().find(|t| t.def.name == table).unwrap();
+        match t.column(name) {
+            Some(ballcage_core::record::ColumnData::U32(v)) => v.clone(),
+            other => panic!("{table}.{name}: {other:?}"),
+        }
+    };
+    let (link_body, body_a, body_b) = (
+        u32s("links", "body"),
+        u32s("contacts", "body_a"),
+        u32s("contacts", "body_b"),
+    );
+    let (link_t, contact_t) = (
+        float_column(&rec, "links", "t"),
+        float_column(&rec, "contacts", "t"),
+    );
+    let tube = float_column(&rec, "links", "tube_normal");
+    let force = float_column(&rec, "contacts", "normal_force");
+    let end = *link_t.last().unwrap();
+    let mut touching = 0;
+    for r in (0..tube.len()).filter(|&r| link_t[r] == end) {
+        let sum: f64 = (0..force.len())
+            .filter(|&c| contact_t[c] == end && body_a[c] == 0 && body_b[c] == link_body[r])
+            .map(|c| force[c])
+            .sum();
+        assert!(
+            (tube[r] - sum).abs() <= 1e-9 * sum.abs().max(1.0),
+            "body {}: links.tube_normal {} N, contacts {} N",
+            link_body[r],
+            tube[r],
+            sum
+        );
+        touching += usize::from(sum > 0.0);
+    }
+    assert!(
+        touching > 0,
+        "no link touches the tube: the check would be empty"
+    );
 }

@@ -12,7 +12,7 @@
 
 mod common;
 
-use ballcage_core::{Scene, Simulation};
+use ballcage_core::{Document, Simulation};
 
 /// Recommended SDIRK2 step of docs/accuracy.md [s].
 const STEP: f64 = 2e-5;
@@ -51,7 +51,7 @@ const EXTREMES: [(&str, &[&str]); 5] = [
     ),
 ];
 
-fn scene(integrator: &str, dt: f64, duration: f64, extremes: &[&str]) -> Scene {
+fn scene(integrator: &str, dt: f64, duration: f64, extremes: &[&str]) -> Document {
     let mut overrides: Vec<String> = [
         "pipe.joints=2",
         "drive.ramp=0.01",
@@ -65,7 +65,7 @@ fn scene(integrator: &str, dt: f64, duration: f64, extremes: &[&str]) -> Scene {
     overrides.push(format!("simulation.integrator=\"{integrator}\""));
     overrides.push(format!("simulation.dt={dt}"));
     overrides.extend(extremes.iter().map(|s| s.to_string()));
-    Scene::from_toml_str("kind = \"drill-pipe\"\n", &overrides)
+    Document::from_toml_str("kind = \"drill-pipe\"\n", &overrides)
         .unwrap_or_else(|e| panic!("bad extreme scene: {e}"))
 }
 
@@ -114,7 +114,7 @@ fn sdirk2_at_the_recommended_step_survives_every_extreme() {
         0.02,
     ));
     for (name, overrides, dt, duration) in cases {
-        let mut sim = Simulation::new(&scene("sdirk2", dt, duration, &overrides)).unwrap();
+        let mut sim = scene("sdirk2", dt, duration, &overrides).simulation();
         sim.run()
             .unwrap_or_else(|e| panic!("{name}: SDIRK2 at {dt} s failed: {e}"));
         let rpm = if overrides.contains(&"drive.speed_rpm=600") {
@@ -144,7 +144,7 @@ fn explicit_integrators_at_that_step_stop_with_a_divergence_error() {
     let all = with_radius(all, &radius);
     for integrator in ["symplectic-euler", "rk4"] {
         for overrides in [Vec::<&str>::new(), all.clone()] {
-            let mut sim = Simulation::new(&scene(integrator, STEP, 0.03, &overrides)).unwrap();
+            let mut sim = scene(integrator, STEP, 0.03, &overrides).simulation();
             let e = sim
                 .run()
                 .expect_err("an explicit step of 20 µs must diverge");

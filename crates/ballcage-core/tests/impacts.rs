@@ -1,5 +1,5 @@
 //! Single impacts of a ball on a rigid flat, no gravity: measured restitution
-//! against the closed forms of physics.md §2.1.
+//! against the closed forms of docs/model.md §2.1.
 //!
 //! For F = Kδⁿ(1 + χδ̇/δ̇⁻) the effective restitution e* solves
 //! χe* + ln(1 − χe*) = ln(1+χ) − χ, independent of m, K, n and v⁻.
@@ -115,7 +115,7 @@ fn undamped_impact_is_elastic_with_the_closed_form_depth_and_duration() {
 
 #[test]
 fn hertz_key_on_steel_lasts_59_5_microseconds() {
-    // physics.md §2.1: Ø15 key (13.872 g) at 0.5 m/s on a steel flat, K_H = 4.213e5 N/mm^1.5.
+    // docs/model.md §2.1: Ø15 key (13.872 g) at 0.5 m/s on a steel flat, K_H = 4.213e5 N/mm^1.5.
     let (_, t, _) = impact(
         r#"{ law = "hertz", stiffness = 4.213e5, units = "N-mm-s" }"#,
         0.013872,
@@ -128,7 +128,7 @@ fn hertz_key_on_steel_lasts_59_5_microseconds() {
 
 #[test]
 fn adams_impact_restitution_matches_the_reference_table() {
-    // physics.md §2.1 [DERIVED, Radau rtol 1e-10]: key 13.87 g and link 8.01 kg on a rigid flat.
+    // docs/model.md §2.1 [DERIVED, Radau rtol 1e-10]: key 13.87 g and link 8.01 kg on a rigid flat.
     let law = r#"{ law = "impact", stiffness = 1e5, exponent = 2.2, damping = 10.0, depth_max = 0.1, units = "N-mm-s" }"#;
     let table = [
         (0.01387, 0.01, 0.594, 1.26e-3),

@@ -341,7 +341,7 @@ fn run_ball(sim: &mut Simulation) -> (Result<(), ballcage_core::SimulationError>
 
 #[test]
 fn stiff_damped_contact_settles_where_symplectic_euler_diverges() {
-    // 6 kN on the key (physics.md §5: δ = 0.278 mm, c/m = 7.1e5 1/s, so
+    // 6 kN on the key (docs/model.md §5: δ = 0.278 mm, c/m = 7.1e5 1/s, so
     // h·c/m = 7 at h = 10 µs, far past symplectic Euler's limit of about 2).
     let (m, k, n) = (0.014, 1e5 * 1000f64.powf(2.2), 2.2);
     let g = 6000.0 / m;
@@ -384,7 +384,7 @@ fn incline(integrator: &str, alpha_deg: f64, dt: f64, duration: f64) -> Simulati
 fn incline_creep_where_symplectic_euler_chatters() {
     // The scene of incline_creep.rs at 25 times its step: symplectic Euler
     // rocks on the vertex springs and tumbles; the implicit step creeps at
-    // v = u·v_s, u(3 − u²)/2 = cot α/μs (physics.md §7.7: 72.0 mm/s at 75°).
+    // v = u·v_s, u(3 − u²)/2 = cot α/μs (docs/model.md §7.7: 72.0 mm/s at 75°).
     let dt = 5e-4;
     let mut explicit = incline("symplectic-euler", 75.0, dt, 0.6);
     let i = common::body(&explicit, "block");

@@ -1,7 +1,7 @@
 //! A block on an incline under the Adams friction law: there is no true
 //! stiction, so below tan⁻¹ the block creeps at the speed where the friction
 //! coefficient balances the slope, μ̂(v) = cot α (α measured from vertical):
-//! v = u·v_s with u(3 − u²)/2 = cot α / μs (physics.md §7.7).
+//! v = u·v_s with u(3 − u²)/2 = cot α / μs (docs/model.md §7.7).
 //!
 //! The incline is modelled by tilting gravity: g = 9.8·(cos α, 0, −sin α) on a
 //! horizontal plane.

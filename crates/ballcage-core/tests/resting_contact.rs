@@ -96,10 +96,7 @@ fn paper_field_units_convert_once_to_si() {
         &[],
     )
     .unwrap();
-    let law = scene.contacts[0]
-        .normal
-        .to_law("contacts[0].normal")
-        .unwrap();
+    let law = ballcage_core::assembly::normal_law(&scene.contacts[0].normal);
     let f = law.evaluate(1e-4, 0.0, 0.0).force;
     assert!((f - 630.957).abs() < 0.01, "F(0.1 mm) = {f} N");
     // Full damping 10 N·s/mm = 1e4 N·s/m beyond d_max: 100 mm/s adds 1000 N.

@@ -22,9 +22,11 @@ bodies = ["ground", "ball"]
 normal = { law = "hertz", stiffness = 1e8 }
 "#;
 
+/// The error of reading, validating or assembling the scene (a geometry
+/// that does not fit the bodies' shapes is found at assembly).
 fn error_of(toml: &str, overrides: &[&str]) -> SceneError {
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    match Scene::from_toml_str(toml, &o) {
+    match Scene::from_toml_str(toml, &o).and_then(|s| Simulation::new(&s)) {
         Ok(_) => panic!("scene was accepted"),
         Err(e) => e,
     }

@@ -247,8 +247,8 @@ fn loaded_key(dt: f64, damping: f64, extra: &str) -> Simulation {
 
 #[test]
 fn stiff_contact_settles_at_a_hundred_times_the_explicit_step() {
-    // physics.md §5: δ = (F/K)^(1/2.2) = 0.278 mm; the contact's ω is about
-    // 1.2e5 rad/s and c/m = 7.1e5 1/s, so symplectic Euler needs h < 2.8 µs.
+    // docs/model.md §5: δ = (F/K)^(1/2.2) = 0.278 mm; the contact's ω is about
+    // 5.8e4 rad/s (k_tan = 2.2·F/δ = 4.7e7 N/m on 14 g) and c/m = 7.1e5 1/s, so symplectic Euler needs h < 2.8 µs.
     // SDIRK2 at 100 µs, with the paper's damping and with none at all
     // (L-stability damps the unresolved oscillation).
     let k = 1e5 * 1000f64.powf(2.2);

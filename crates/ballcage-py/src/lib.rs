@@ -6,7 +6,8 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use ballcage_core::scene::{IntegratorKind, TableKind};
+use ballcage_core::loader::{self, Document, Kind};
+use ballcage_core::scene::{IntegratorKind, whole_multiple as core_whole_multiple};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -40,10 +41,33 @@ fn sim_err(e: ballcage_core::SimulationError) -> PyErr {
     SimulationError::new_err(e.to_string())
 }
 
-/// A validated scene.
+/// A validated, assembled scene document of any kind.
 #[pyclass(module = "ballcage._native", frozen)]
 struct Scene {
-    inner: ballcage_core::Scene,
+    inner: Document,
+}
+
+impl Scene {
+    /// The drill-pipe document, or a `SceneError` on `kind` naming `what` needs one.
+    fn drill_pipe(
+        &self,
+        py: Python<'_>,
+        what: &str,
+    ) -> PyResult<&ballcage_core::drillpipe::DrillPipeSpec> {
+        self.inner
+            .drill_pipe_parts()
+            .map(|(spec, _)| spec)
+            .ok_or_else(|| {
+                scene_err(
+                    py,
+                    ballcage_core::SceneError::new(
+                        "kind",
+                        self.inner.kind().name(),
+                        format!("{what} needs a drill-pipe scene (kind = \"drill-pipe\")"),
+                    ),
+                )
+            })
+    }
 }
 
 #[pymethods]
@@ -52,7 +76,7 @@ impl Scene {
     #[staticmethod]
     #[pyo3(signature = (text, overrides = Vec::new()))]
     fn from_toml(py: Python<'_>, text: &str, overrides: Vec<String>) -> PyResult<Self> {
-        ballcage_core::Scene::from_toml_str(text, &overrides)
+        Document::from_toml_str(text, &overrides)
             .map(|inner| Self { inner })
             .map_err(|e| scene_err(py, e))
     }
@@ -71,7 +95,7 @@ impl Scene {
                 ballcage_core::SceneError::new("", "", format!("not a scene table: {e}")),
             )
         })?;
-        ballcage_core::Scene::from_table(table, &overrides)
+        Document::from_table(table, &overrides)
             .map(|inner| Self { inner })
             .map_err(|e| scene_err(py, e))
     }
@@ -84,47 +108,95 @@ impl Scene {
     /// Scene name.
     #[getter]
     fn name(&self) -> String {
-        self.inner.name.clone()
+        self.inner.scene().name.clone()
     }
 
     /// Simulated duration [s].
     #[getter]
     fn duration(&self) -> f64 {
-        self.inner.simulation.duration
+        self.inner.scene().simulation.duration
     }
 
     /// Integrator step [s].
     #[getter]
     fn dt(&self) -> f64 {
-        self.inner.simulation.dt
+        self.inner.scene().simulation.dt
     }
 
     /// Output interval [s].
     #[getter]
     fn output_interval(&self) -> f64 {
-        self.inner.simulation.output_interval
+        self.inner.scene().simulation.output_interval
     }
 
     /// Integrator name.
     #[getter]
     fn integrator(&self) -> &'static str {
-        self.inner.simulation.integrator.name()
+        self.inner.scene().simulation.integrator.name()
     }
 
     /// Names of the tables this scene records.
     #[getter]
     fn table_names(&self) -> Vec<&'static str> {
-        self.inner.record.tables.iter().map(|t| t.name()).collect()
+        self.inner.table_names()
+    }
+
+    /// The scene kind: "generic" or "drill-pipe".
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.inner.kind().name()
+    }
+
+    /// The resolved value at a dotted key of the scene document.
+    fn value<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        let v = self.inner.value(key).map_err(|e| scene_err(py, e))?;
+        pythonize::pythonize(py, &v)
+            .map_err(|e| PyRuntimeError::new_err(format!("scene value `{key}`: {e}")))
+    }
+
+    /// The tightest guide-tube curvature radius [m] the drill pipe allows.
+    fn tightest_radius(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.drill_pipe(py, "tightest_radius")?.tightest_radius())
+    }
+
+    /// `count` points along the drill pipe's extended tube centreline.
+    fn centreline<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
+        let spec = self.drill_pipe(py, "centreline")?;
+        if count < 2 {
+            return Err(PyValueError::new_err(format!(
+                "count = {count}: must be at least 2 points"
+            )));
+        }
+        let (_, layout) = self.inner.drill_pipe_parts().expect("checked above");
+        let path = spec.extended_centreline();
+        let (mut point, mut tangent, mut outward, mut s) = (vec![], vec![], vec![], vec![]);
+        for i in 0..count {
+            let arc = path.length() * i as f64 / (count - 1) as f64;
+            let c = path.point_at(arc);
+            let o = layout.lateral.cross(&c.tangent);
+            point.push(vec![c.point.x, c.point.y, c.point.z]);
+            tangent.push(vec![c.tangent.x, c.tangent.y, c.tangent.z]);
+            outward.push(vec![o.x, o.y, o.z]);
+            s.push(arc);
+        }
+        let out = PyDict::new(py);
+        out.set_item("point", point)?;
+        out.set_item("tangent", tangent)?;
+        out.set_item("outward", outward)?;
+        out.set_item("s", s)?;
+        Ok(out)
     }
 
     fn __repr__(&self) -> String {
+        let s = self.inner.scene();
         format!(
-            "Scene(name={:?}, bodies={}, contacts={}, duration={} s, dt={} s)",
-            self.inner.name,
-            self.inner.bodies.len(),
-            self.inner.contacts.len(),
-            self.inner.simulation.duration,
-            self.inner.simulation.dt
+            "Scene(kind={:?}, name={:?}, bodies={}, contacts={}, duration={} s, dt={} s)",
+            self.inner.kind().name(),
+            s.name,
+            s.bodies.len(),
+            s.contacts.len(),
+            s.simulation.duration,
+            s.simulation.dt
         )
     }
 }
@@ -146,9 +218,10 @@ impl Simulation {
 #[pymethods]
 impl Simulation {
     #[new]
-    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
-        let sim = ballcage_core::Simulation::new(&scene.inner).map_err(|e| scene_err(py, e))?;
-        Ok(Self { inner: Some(sim) })
+    fn new(scene: &Scene) -> Self {
+        Self {
+            inner: Some(scene.inner.simulation()),
+        }
     }
 
     /// Simulated time reached [s].
@@ -192,10 +265,10 @@ impl Simulation {
         let batches = ballcage_core::output::record_batches(sim.finish())
             .map_err(|e| PyRuntimeError::new_err(format!("building Arrow tables failed: {e}")))?;
         let out = PyDict::new(py);
-        for (kind, batch) in batches {
+        for (def, batch) in batches {
             let schema = batch.schema();
             let table = PyTable::try_new(vec![batch], schema)?;
-            out.set_item(kind.name(), table.into_pyarrow(py)?)?;
+            out.set_item(def.name, table.into_pyarrow(py)?)?;
         }
         Ok(out)
     }
@@ -204,21 +277,41 @@ impl Simulation {
 /// The embedded default scene (the paper's drill pipe) as TOML.
 #[pyfunction]
 fn default_scene_toml() -> String {
-    ballcage_core::drillpipe::DrillPipeSpec::default().to_toml()
+    loader::default_document().to_toml()
 }
 
-/// The Arrow schema of an output table (`bodies`, `contacts`, `energy`).
+/// The Arrow schema of an output table of any scene kind.
 #[pyfunction]
 fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
-    let kind = TableKind::from_name(name).ok_or_else(|| {
-        let names: Vec<&str> = TableKind::ALL.iter().map(|k| k.name()).collect();
+    let def = loader::table(name).ok_or_else(|| {
+        let names: Vec<&str> = loader::tables().iter().map(|t| t.name).collect();
         PyValueError::new_err(format!(
             "table `{name}`: unknown (tables are {})",
             names.join(", ")
         ))
     })?;
-    let schema = ballcage_core::output::schema(kind, HashMap::new());
+    let schema = ballcage_core::output::schema(def, HashMap::new());
     PySchema::new(Arc::new(schema)).into_pyarrow(py)
+}
+
+/// Per integrator: whether it is implicit, its order and a description.
+#[pyfunction]
+fn integrator_facts(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let out = PyDict::new(py);
+    for k in IntegratorKind::ALL {
+        let facts = PyDict::new(py);
+        facts.set_item("implicit", k.is_implicit())?;
+        facts.set_item("order", k.order())?;
+        facts.set_item("description", k.description())?;
+        out.set_item(k.name(), facts)?;
+    }
+    Ok(out)
+}
+
+/// `interval / step` when it is a whole number ≥ 1 (the engine's tolerance).
+#[pyfunction]
+fn whole_multiple(interval: f64, step: f64) -> Option<u64> {
+    core_whole_multiple(interval, step)
 }
 
 #[pymodule]
@@ -239,9 +332,15 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(table_schema, m)?)?;
     m.add_function(wrap_pyfunction!(default_scene_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(integrator_facts, m)?)?;
+    m.add_function(wrap_pyfunction!(whole_multiple, m)?)?;
     m.add(
         "TABLE_NAMES",
-        TableKind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>(),
+        loader::tables().iter().map(|t| t.name).collect::<Vec<_>>(),
+    )?;
+    m.add(
+        "SCENE_KINDS",
+        Kind::ALL.iter().map(|k| k.name()).collect::<Vec<_>>(),
     )?;
     m.add(
         "INTEGRATORS",

@@ -1,4 +1,4 @@
-//! Chain placement along the borehole centreline (physics.md §4, Option A).
+//! Chain placement along the borehole centreline (docs/model.md §4, Option A).
 //!
 //! Hinge 0 sits at the start of the guide tube's arc; each next hinge lies on
 //! the centreline (the arc, then its straight tangent extension) at one pitch
@@ -36,7 +36,7 @@ pub fn bend_angle(a: &Vec3, b: &Vec3, z: &Vec3) -> f64 {
 }
 
 /// The paper's eq. (4): centres of mass of links 0…i from their angles,
-/// mapped to the world frame (x = Y_p, y = X_p, z = l − Z_p; physics.md §1.2).
+/// mapped to the world frame (x = Y_p, y = X_p, z = l − Z_p; docs/model.md §1.2).
 /// `angles[k] = (φ_k, θ_k)` [rad]: inclination from the downward vertical and
 /// azimuth from the bend direction. Link 0 is the upper connector; every link
 /// has length `pitch` [m].
@@ -86,7 +86,7 @@ pub fn eq4_angles(axis: &Vec3) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::TubeSegmentSpec;
+    use crate::geometry::TubeSegment;
 
     fn paper_centreline(r: f64) -> TubePath {
         TubePath::new(
@@ -94,19 +94,19 @@ mod tests {
             Vec3::zeros(),
             Vec3::new(0.0, 0.0, -1.0),
             &[
-                TubeSegmentSpec::Arc {
+                TubeSegment::Arc {
                     radius: r,
-                    angle_deg: 90.0,
-                    bend: [1.0, 0.0, 0.0],
+                    angle: std::f64::consts::FRAC_PI_2,
+                    bend: Vec3::x(),
                 },
-                TubeSegmentSpec::Straight { length: 5.0 },
+                TubeSegment::Straight { length: 5.0 },
             ],
         )
     }
 
     #[test]
     fn option_a_hinges_of_the_paper_chain() {
-        // physics.md §4: Δα = 2·asin(100/1500) = 7.6451°, hinges 1–11 on the arc,
+        // docs/model.md §4: Δα = 2·asin(100/1500) = 7.6451°, hinges 1–11 on the arc,
         // hinge 12 at (1545.55, 0, −1500) mm.
         let h = place_hinges(&paper_centreline(1.5), 0.2, 13);
         let da = 2.0 * (0.1f64 / 1.5).asin();
@@ -175,7 +175,7 @@ mod tests {
 
     #[test]
     fn adjacent_links_include_172_355_degrees() {
-        // physics.md §7.5: 180° − 7.645° for a 200 mm pitch on R = 1.5 m.
+        // docs/model.md §7.5: 180° − 7.645° for a 200 mm pitch on R = 1.5 m.
         let h = place_hinges(&paper_centreline(1.5), 0.2, 13);
         let z = Vec3::new(0.0, -1.0, 0.0);
         for k in 1..11 {

@@ -1,4 +1,4 @@
-//! Exact ball-cage (Rzeppa) constant-velocity geometry (physics.md §1.1).
+//! Exact ball-cage (Rzeppa) constant-velocity geometry (docs/model.md §1.1).
 //!
 //! Hinge frame: origin at the joint centre O, x̂ the head-body axis (downhole),
 //! bending by β about ẑ, so the seat-body axis is e_s = R_z(β)x̂. The head
@@ -37,7 +37,7 @@ impl CvGeometry {
     }
 
     /// Ball centre parametrized by its angle ψ in the bisector plane
-    /// (physics.md §1.1): p = c·sin(β/2)·t + r_c(cos ψ·t + sin ψ·ẑ).
+    /// (docs/model.md §1.1): p = c·sin(β/2)·t + r_c(cos ψ·t + sin ψ·ẑ).
     pub fn ball_centre_at(&self, beta: f64, psi: f64) -> Vec3 {
         let c = self.groove_offset;
         let rho = self.track_radius();
@@ -94,7 +94,7 @@ mod tests {
 
     #[test]
     fn balls_are_equidistant_from_both_groove_centres_and_in_the_bisector_plane() {
-        // physics.md §7.4: to 1e-9 mm = 1e-12 m, for bends 0–20°.
+        // docs/model.md §7.4: to 1e-9 mm = 1e-12 m, for bends 0–20°.
         let rho = PAPER.track_radius();
         for deg in [0.0, 1.0, 3.82, 7.645, 12.0, 15.0, 20.0] {
             let beta = f64::to_radians(deg);

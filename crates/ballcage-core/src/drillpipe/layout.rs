@@ -1,11 +1,12 @@
-//! Where the drill pipe's parts sit in an assembled model, for the derived tables.
+//! Where the drill pipe's parts sit in its expanded scene: body and pair ids
+//! recorded by [`DrillPipeSpec::expand`](super::DrillPipeSpec::expand) as it
+//! builds each part.
 
-use super::DrillPipeSpec;
-use crate::geometry::TubePath;
-use crate::model::{Body, ContactPair};
+use crate::geometry::{CentrelinePoint, TubePath};
+use crate::math::Vec3;
 
-/// Pair indices of one ball key.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// Pair ids of one ball key.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct KeyLayout {
     /// Inner-race (head) flanks.
     pub inner: Vec<usize>,
@@ -15,64 +16,51 @@ pub struct KeyLayout {
     pub window: Vec<usize>,
 }
 
-/// Pair indices of one hinge.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// Pair ids of one hinge; empty for an ideal-CV hinge (no cage, no keys).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct HingeLayout {
     /// Cage–head pair.
     pub cage_head: Option<usize>,
     /// Cage–seat pair.
     pub cage_seat: Option<usize>,
-    /// The ball keys.
+    /// The ball keys, 0–5 around the joint.
     pub keys: Vec<KeyLayout>,
 }
 
-/// Body and pair indices of a drill pipe in its model.
+/// Body and pair ids of a drill pipe in its scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layout {
-    /// Bodies in chain order: upper connector, links 1…N, lower connector.
+    /// Body ids in chain order: upper connector, links 1…n, lower connector.
     pub chain: Vec<usize>,
-    /// Hinges 0…N (without ball keys: no cage pairs and no keys).
+    /// Pair id of link k's contact with the tube at index k − 1.
+    pub tube_pairs: Vec<usize>,
+    /// Hinges 0…n; hinge k joins chain bodies k and k + 1.
     pub hinges: Vec<HingeLayout>,
-    /// The tube centreline extended straight past the arc [m].
+    /// The tube centreline, extended straight past the arc [m].
     pub centreline: TubePath,
+    /// Unit normal of the bend plane, world frame: the lateral direction of
+    /// [`Layout::offsets`].
+    pub lateral: Vec3,
 }
 
 impl Layout {
-    /// Finds the parts by the names [`DrillPipeSpec::expand`] gives them.
-    pub fn new(spec: &DrillPipeSpec, bodies: &[Body], pairs: &[ContactPair]) -> Self {
-        let n = spec.pipe.joints;
-        let body = |name: &str| bodies.iter().position(|b| b.name == name);
-        let pair = |name: &str| pairs.iter().position(|p| p.name == name);
-        let chain = std::iter::once("upper".to_string())
-            .chain((1..=n).map(|k| format!("link{k:02}")))
-            .chain(std::iter::once("lower".to_string()))
-            .filter_map(|name| body(&name))
-            .collect();
-        let hinges = (0..=n)
-            .map(|h| HingeLayout {
-                cage_head: pair(&format!("h{h:02}.cage/head")),
-                cage_seat: pair(&format!("h{h:02}.cage/seat")),
-                keys: (0..6)
-                    .map(|j| {
-                        let find = |tags: &[&str]| {
-                            tags.iter()
-                                .filter_map(|t| pair(&format!("h{h:02}.key{j}/{t}")))
-                                .collect()
-                        };
-                        KeyLayout {
-                            inner: find(&["head+", "head-"]),
-                            outer: find(&["seat+", "seat-"]),
-                            window: find(&["window-axial", "window-side"]),
-                        }
-                    })
-                    .filter(|k| !k.inner.is_empty())
-                    .collect(),
-            })
-            .collect();
-        Self {
-            chain,
-            hinges,
-            centreline: spec.centreline(2.0 * n as f64 * spec.pipe.pitch),
-        }
+    /// Offsets of point `p` [m] from the extended centreline: total distance,
+    /// in-plane (+ toward the outer wall of the bend) and lateral (along
+    /// [`Layout::lateral`]). Points before the tube's start are measured from it.
+    pub fn offsets(&self, p: &Vec3) -> (f64, f64, f64) {
+        let (c, distance) = match self.centreline.nearest(p) {
+            Some(c) => {
+                let d = (p - c.point).norm();
+                (c, d)
+            }
+            None => {
+                let c: CentrelinePoint = self.centreline.point_at(0.0);
+                let d = (p - c.point).norm();
+                (c, d)
+            }
+        };
+        let outward = self.lateral.cross(&c.tangent);
+        let r = p - c.point;
+        (distance, r.dot(&outward), r.dot(&self.lateral))
     }
 }

@@ -8,7 +8,7 @@
 //! spun by φ about its axis and a seat spun by φ about its own give a relative
 //! rotation about an axis perpendicular to x.
 
-use crate::math::{Quat, Vec3};
+use crate::math::{Quat, Vec3, angle_between};
 
 /// Parameters of an ideal CV joint (SI).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,6 +55,13 @@ pub fn twist_axis(qa: &Quat, qb: &Quat) -> Vec3 {
     (ea + eb).try_normalize(1e-12).unwrap_or(ea)
 }
 
+/// Bend β between the two body x axes [rad], and the unit axis of
+/// e_a × e_b about which the bend opens (`None` when the axes are parallel).
+pub fn bend(qa: &Quat, qb: &Quat) -> (f64, Option<Vec3>) {
+    let (ea, eb) = (qa * Vec3::x(), qb * Vec3::x());
+    (angle_between(&ea, &eb), ea.cross(&eb).try_normalize(1e-12))
+}
+
 /// Wrench of a CV joint. `pa`, `pb`: hinge points [m]; `va`, `vb`: their
 /// velocities [m/s]; `wa`, `wb`: angular velocities [rad/s]; all world frame.
 #[allow(clippy::too_many_arguments)]
@@ -70,14 +77,12 @@ pub fn cv_joint_wrench(
     p: &CvJointParams,
 ) -> JointWrench {
     let force = -p.stiffness * (pb - pa) - p.damping * (vb - va);
-    let (ea, eb) = (qa * Vec3::x(), qb * Vec3::x());
     let axis = twist_axis(qa, qb);
     let twist = twist_angle(qa, qb);
     let mut torque = -(p.twist_stiffness * twist + p.twist_damping * (wb - wa).dot(&axis)) * axis;
-    let cross = ea.cross(&eb);
-    let bend = cross.norm().atan2(ea.dot(&eb));
+    let (bend, opening) = bend(qa, qb);
     if bend > p.bend_limit
-        && let Some(u) = cross.try_normalize(1e-12)
+        && let Some(u) = opening
     {
         torque -= p.stop_stiffness * (bend - p.bend_limit) * u;
     }

@@ -18,13 +18,12 @@
 
 mod tube;
 
-pub use tube::{CentrelinePoint, TubePath};
+pub use tube::{CentrelinePoint, TubePath, TubeSegment};
 
 use parry3d_f64::query;
 use parry3d_f64::shape::{Ball, Cuboid, HalfSpace};
 
 use crate::math::{Quat, Vec3, from_glam, to_glam, to_glam_pose};
-use crate::scene::ShapeSpec;
 
 /// A shape ready for queries.
 #[derive(Debug, Clone)]
@@ -60,36 +59,20 @@ impl Shape {
         }
     }
 
-    /// Builds the query shape of a validated spec.
-    pub fn from_spec(spec: &ShapeSpec) -> Self {
-        match spec {
-            ShapeSpec::Ball { radius } => Self::Ball(Ball::new(*radius)),
-            ShapeSpec::Cuboid { half_extents } => {
-                Self::Cuboid(Cuboid::new(to_glam(&Vec3::from(*half_extents))))
-            }
-            ShapeSpec::HalfSpace { normal } => {
-                Self::HalfSpace(HalfSpace::new(to_glam(&Vec3::from(*normal).normalize())))
-            }
-            ShapeSpec::Cylinder {
-                radius,
-                half_length,
-                ..
-            } => Self::Cylinder {
-                radius: *radius,
-                half_length: *half_length,
-            },
-            ShapeSpec::Tube {
-                inner_radius,
-                start,
-                direction,
-                segments,
-            } => Self::Tube(TubePath::new(
-                *inner_radius,
-                Vec3::from(*start),
-                Vec3::from(*direction),
-                segments,
-            )),
-        }
+    /// A sphere of `radius` [m] centred at the body origin.
+    pub fn ball(radius: f64) -> Self {
+        Self::Ball(Ball::new(radius))
+    }
+
+    /// A box of `half_extents` [m] along the body axes.
+    pub fn cuboid(half_extents: Vec3) -> Self {
+        Self::Cuboid(Cuboid::new(to_glam(&half_extents)))
+    }
+
+    /// A half-space with outward boundary `normal` (normalized here), its
+    /// plane through the body origin.
+    pub fn half_space(normal: Vec3) -> Self {
+        Self::HalfSpace(HalfSpace::new(to_glam(&normal.normalize())))
     }
 }
 
@@ -165,18 +148,18 @@ impl PairGeometry {
     /// The method for a pair of shapes in either order (with the
     /// cylinder–tube sample count), or `None` if unsupported. The returned
     /// flag is true when the canonical order is (b, a).
-    pub fn select(a: &ShapeSpec, b: &ShapeSpec, points: u32) -> Option<(Self, bool)> {
-        use ShapeSpec as S;
-        let canonical = |x: &ShapeSpec, y: &ShapeSpec| -> Option<Self> {
+    pub fn select(a: &Shape, b: &Shape, points: u32) -> Option<(Self, bool)> {
+        use Shape as S;
+        let canonical = |x: &Shape, y: &Shape| -> Option<Self> {
             match (x, y) {
                 // Half-space first: parry 0.30's support-map–half-space order
                 // applies the relative pose uninverted (wrong depth); the
                 // half-space–support-map order is correct.
-                (S::HalfSpace { .. }, S::Ball { .. }) => Some(Self::ParryConvex),
-                (S::Ball { .. }, S::Ball { .. } | S::Cuboid { .. }) => Some(Self::ParryConvex),
-                (S::Cuboid { .. }, S::HalfSpace { .. }) => Some(Self::CuboidHalfSpace),
-                (S::Tube { .. }, S::Cylinder { .. }) => Some(Self::CylinderTube { points }),
-                (S::Tube { .. }, S::Ball { .. }) => Some(Self::BallTube),
+                (S::HalfSpace(_), S::Ball(_)) => Some(Self::ParryConvex),
+                (S::Ball(_), S::Ball(_) | S::Cuboid(_)) => Some(Self::ParryConvex),
+                (S::Cuboid(_), S::HalfSpace(_)) => Some(Self::CuboidHalfSpace),
+                (S::Tube(_), S::Cylinder { .. }) => Some(Self::CylinderTube { points }),
+                (S::Tube(_), S::Ball(_)) => Some(Self::BallTube),
                 _ => None,
             }
         };
@@ -527,10 +510,8 @@ mod tests {
 
     #[test]
     fn ball_on_half_space_depth_and_normal_follow_the_convention() {
-        let ground = ShapeSpec::HalfSpace {
-            normal: [0.0, 0.0, 1.0],
-        };
-        let ball = ShapeSpec::Ball { radius: 0.1 };
+        let ground = Shape::half_space(Vec3::z());
+        let ball = Shape::ball(0.1);
         // Declared either way round, the pair resolves to half-space first.
         assert_eq!(
             PairGeometry::select(&ball, &ground, 5),
@@ -540,7 +521,6 @@ mod tests {
             PairGeometry::select(&ground, &ball, 5),
             Some((PairGeometry::ParryConvex, false))
         );
-        let (ground, ball) = (Shape::from_spec(&ground), Shape::from_spec(&ball));
         for z in [0.099, 0.0999, 0.05] {
             let (g, b) = (pose([0.3, -0.2, 0.0]), pose([0.0, 0.0, z]));
             let mut out = vec![];
@@ -565,10 +545,8 @@ mod tests {
 
     #[test]
     fn ball_against_a_cuboid_face_has_the_face_normal() {
-        let ball = Shape::from_spec(&ShapeSpec::Ball { radius: 0.05 });
-        let cube = Shape::from_spec(&ShapeSpec::Cuboid {
-            half_extents: [0.1, 0.2, 0.3],
-        });
+        let ball = Shape::ball(0.05);
+        let cube = Shape::cuboid(Vec3::new(0.1, 0.2, 0.3));
         let (pb, pc) = (pose([-0.149, 0.01, 0.02]), pose([0.0; 3]));
         let mut out = vec![];
         PairGeometry::ParryConvex.contacts(&ball, (&pb.0, &pb.1), &cube, (&pc.0, &pc.1), &mut out);
@@ -579,7 +557,7 @@ mod tests {
 
     #[test]
     fn separated_balls_have_no_contact_and_overlapping_ones_have_one() {
-        let a = Shape::from_spec(&ShapeSpec::Ball { radius: 0.1 });
+        let a = Shape::ball(0.1);
         let (p1, p2, p3) = (
             pose([0.0; 3]),
             pose([0.21, 0.0, 0.0]),
@@ -595,12 +573,8 @@ mod tests {
 
     #[test]
     fn tilted_cuboid_touches_with_its_lowest_vertices() {
-        let c = Shape::from_spec(&ShapeSpec::Cuboid {
-            half_extents: [0.1, 0.2, 0.3],
-        });
-        let h = Shape::from_spec(&ShapeSpec::HalfSpace {
-            normal: [0.0, 0.0, 1.0],
-        });
+        let c = Shape::cuboid(Vec3::new(0.1, 0.2, 0.3));
+        let h = Shape::half_space(Vec3::z());
         let (pc, ph) = (pose([0.0, 0.0, 0.299]), pose([0.0; 3]));
         let mut out = vec![];
         PairGeometry::CuboidHalfSpace.contacts(&c, (&pc.0, &pc.1), &h, (&ph.0, &ph.1), &mut out);
@@ -694,12 +668,12 @@ mod tests {
 
     #[test]
     fn cylinder_lying_in_a_straight_tube_touches_along_its_bottom_line() {
-        let tube = Shape::from_spec(&ShapeSpec::Tube {
-            inner_radius: 0.058,
-            start: [-1.0, 0.0, 0.0],
-            direction: [1.0, 0.0, 0.0],
-            segments: vec![crate::scene::TubeSegmentSpec::Straight { length: 2.0 }],
-        });
+        let tube = Shape::Tube(TubePath::new(
+            0.058,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::x(),
+            &[TubeSegment::Straight { length: 2.0 }],
+        ));
         let cyl = Shape::Cylinder {
             radius: 0.043,
             half_length: 0.1,

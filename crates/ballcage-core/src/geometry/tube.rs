@@ -6,9 +6,29 @@
 //! centreline minus the inner radius.
 
 use crate::math::Vec3;
-use crate::scene::TubeSegmentSpec;
 
-/// One centreline piece.
+/// One piece of a tube centreline as declared: it continues from where the
+/// previous piece ends, along the current direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TubeSegment {
+    /// Straight piece along the current direction.
+    Straight {
+        /// Length [m].
+        length: f64,
+    },
+    /// Circular arc turning the current direction toward `bend`.
+    Arc {
+        /// Centreline curvature radius [m].
+        radius: f64,
+        /// Turned angle [rad].
+        angle: f64,
+        /// Direction toward the arc's centre (tube frame); only its part
+        /// across the current direction is used.
+        bend: Vec3,
+    },
+}
+
+/// One centreline piece, placed.
 #[derive(Debug, Clone, PartialEq)]
 enum Segment {
     /// `start + s·dir`, s ∈ [0, length].
@@ -47,15 +67,17 @@ pub struct TubePath {
 }
 
 impl TubePath {
-    /// Builds the path from validated segment specs.
-    pub fn new(inner_radius: f64, start: Vec3, direction: Vec3, specs: &[TubeSegmentSpec]) -> Self {
+    /// Builds the path of `specs` from `start` along `direction` (both tube
+    /// frame); lengths, radii and angles positive, `bend` not along the
+    /// direction it turns.
+    pub fn new(inner_radius: f64, start: Vec3, direction: Vec3, specs: &[TubeSegment]) -> Self {
         let mut p = start;
         let mut d = direction.normalize();
         let mut segments = Vec::with_capacity(specs.len());
         let mut length = 0.0;
         for s in specs {
             match *s {
-                TubeSegmentSpec::Straight { length: l } => {
+                TubeSegment::Straight { length: l } => {
                     segments.push(Segment::Straight {
                         start: p,
                         dir: d,
@@ -64,16 +86,14 @@ impl TubePath {
                     p += l * d;
                     length += l;
                 }
-                TubeSegmentSpec::Arc {
+                TubeSegment::Arc {
                     radius,
-                    angle_deg,
-                    bend,
+                    angle,
+                    bend: b,
                 } => {
-                    let b = Vec3::from(bend);
                     let b = (b - b.dot(&d) * d).normalize();
                     let center = p + radius * b;
                     let (u, t) = (-b, d);
-                    let angle = angle_deg.to_radians();
                     segments.push(Segment::Arc {
                         center,
                         radius,
@@ -218,10 +238,10 @@ mod tests {
             0.058,
             Vec3::zeros(),
             Vec3::new(0.0, 0.0, -1.0),
-            &[TubeSegmentSpec::Arc {
+            &[TubeSegment::Arc {
                 radius: 1.5,
-                angle_deg: 90.0,
-                bend: [1.0, 0.0, 0.0],
+                angle: 90f64.to_radians(),
+                bend: Vec3::x(),
             }],
         )
     }
@@ -279,11 +299,11 @@ mod tests {
             Vec3::zeros(),
             Vec3::new(1.0, 0.0, 0.0),
             &[
-                TubeSegmentSpec::Straight { length: 1.0 },
-                TubeSegmentSpec::Arc {
+                TubeSegment::Straight { length: 1.0 },
+                TubeSegment::Arc {
                     radius: 2.0,
-                    angle_deg: 30.0,
-                    bend: [0.0, 1.0, 0.0],
+                    angle: 30f64.to_radians(),
+                    bend: Vec3::y(),
                 },
             ],
         );

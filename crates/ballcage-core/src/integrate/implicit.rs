@@ -20,7 +20,7 @@
 //!    symplectic Euler; then the prescribed bodies are set at t + h.
 //!
 //! With D = 0 this is exactly symplectic Euler. Contact damping and friction
-//! (the stiff, overdamped modes, physics.md §5) are integrated with the
+//! (the stiff, overdamped modes, docs/model.md §5) are integrated with the
 //! L-stable backward-Euler amplification; the elastic and gyroscopic terms
 //! stay explicit.
 //!
@@ -211,65 +211,10 @@ const REFRESH_CONTRACTION: f64 = 0.3;
 impl Implicit {
     /// Builds the sparsity pattern of `model` and factors it symbolically.
     pub(crate) fn new(model: &Model) -> Self {
-        let mut dofs = vec![None; model.bodies.len()];
-        let mut n = 0;
-        for &i in &model.integrated {
-            let basis = match model.bodies[i].motion {
-                Motion::Spin { axis, .. } => Basis::Axis(axis),
-                _ => Basis::Full,
-            };
-            dofs[i] = Some((n, basis));
-            n += basis.dim();
-        }
-        let mut mass_scale = vec![0.0; n];
-        for &i in &model.integrated {
-            let (off, basis) = dofs[i].expect("integrated");
-            let body = &model.bodies[i];
-            match (basis, body.motion) {
-                (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass_scale[off] = inertia,
-                _ => {
-                    let rot = body.inertia.max();
-                    mass_scale[off..off + 6]
-                        .copy_from_slice(&[body.mass, body.mass, body.mass, rot, rot, rot]);
-                }
-            }
-        }
+        let (dofs, n) = unknowns(model);
+        let mass_scale = mass_scales(model, &dofs, n);
         let jac = VelocityJacobian::new(model);
-        // Row bodies of each column body.
-        let mut rows: BTreeMap<usize, BTreeSet<(usize, usize)>> = BTreeMap::new();
-        for &i in &model.integrated {
-            let (off, _) = dofs[i].expect("integrated");
-            rows.entry(off).or_default().insert((off, i));
-        }
-        for c in &jac.couplings {
-            if let (Some((oa, _)), Some((ob, _))) = (dofs[c.a], dofs[c.b]) {
-                rows.entry(oa).or_default().insert((ob, c.b));
-                rows.entry(ob).or_default().insert((oa, c.a));
-            }
-        }
-        let mut col_ptr = vec![0usize];
-        let mut row_idx = vec![];
-        let mut blocks: BTreeMap<(usize, usize), Block> = BTreeMap::new();
-        for (&col0, row_bodies) in &rows {
-            let j = row_bodies
-                .iter()
-                .find(|&&(o, _)| o == col0)
-                .map(|&(_, j)| j)
-                .expect("diagonal");
-            let width = dofs[j].expect("integrated").1.dim();
-            let mut row_off = 0;
-            let mut pattern = vec![];
-            for &(off, i) in row_bodies {
-                let dim = dofs[i].expect("integrated").1.dim();
-                blocks.insert((i, j), Block { col0, row_off });
-                pattern.extend(off..off + dim);
-                row_off += dim;
-            }
-            for _ in 0..width {
-                row_idx.extend_from_slice(&pattern);
-                col_ptr.push(row_idx.len());
-            }
-        }
+        let (col_ptr, row_idx, blocks) = block_pattern(model, &dofs, &jac);
         let diag = model
             .integrated
             .iter()
@@ -284,29 +229,7 @@ impl Implicit {
             })
             .collect();
         let values = vec![0.0; row_idx.len()];
-        let col_ptr_pattern = col_ptr.clone();
-        let lu = (n > 0).then(|| {
-            let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr_pattern, None, row_idx);
-            // Supernodal: the pattern is made of dense 6×6 blocks; on the
-            // paper scene it factors 3.7 times faster than the simplicial
-            // variant faer picks by default.
-            let params = LuSymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            };
-            let symbolic = factorize_symbolic_lu(pattern.as_ref(), params)
-                .expect("symbolic LU of the contact pattern");
-            let req = StackReq::any_of(&[
-                symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-                symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-            ]);
-            Factorization {
-                pattern,
-                symbolic,
-                numeric: NumericLu::new(),
-                scratch: Scratch::new(req),
-            }
-        });
+        let lu = (n > 0).then(|| Factorization::new(n, col_ptr.clone(), row_idx));
         Self {
             dofs,
             n,
@@ -484,16 +407,7 @@ impl Implicit {
             // overshoot deep into a contact on its way to the solution.
             dynamics.watch.reset();
             if self.refresh || !self.factored || self.factored_gh != gh {
-                dynamics.forces_and_jacobian(model, stage, Mode::Trial, gh, &mut self.jac);
-                self.assemble_matrix(model, stage, gh);
-                if !self.factor() {
-                    return Err(format!(
-                        "the Newton matrix of SDIRK2 stage {} is singular",
-                        s + 1
-                    ));
-                }
-                self.refresh = false;
-                self.factored_gh = gh;
+                self.refresh_matrix(model, dynamics, stage, s, gh)?;
                 previous = f64::INFINITY;
             } else {
                 dynamics.wrenches(model, stage, Mode::Trial);
@@ -504,36 +418,16 @@ impl Implicit {
             let residual = self.residual_norm();
             if residual > last_residual && backtracks < MAX_BACKTRACKS {
                 backtracks += 1;
-                for i in 0..self.n {
-                    self.step[i] *= 0.5;
-                    self.v[i] -= self.step[i];
-                }
-                self.refresh = true;
+                self.halve_increment();
                 continue;
             }
             backtracks = 0;
             last_residual = residual;
-            if !self.solve() {
-                return Err(format!(
-                    "the Newton increment of SDIRK2 stage {} is not finite",
-                    s + 1
-                ));
-            }
-            let mut norm = 0.0f64;
-            for i in 0..self.n {
-                self.step[i] = self.rhs[i];
-                self.v[i] += self.rhs[i];
-                norm = norm.max(self.rhs[i].abs() / (self.v[i].abs() + 1.0));
-            }
+            let norm = self.increment(s)?;
             // The contraction rate, unknown at the first iteration of a Jacobian.
             let theta = (previous.is_finite()).then(|| norm / previous);
             previous = norm;
-            let converged = match theta {
-                _ if norm <= 0.01 * settings.tolerance => true,
-                Some(theta) => theta < 1.0 && theta / (1.0 - theta) * norm <= settings.tolerance,
-                None => false,
-            };
-            if converged {
+            if converged(norm, theta, settings.tolerance) {
                 self.set_stage(model, start, stage, s, t_stage, h);
                 return Ok(k);
             }
@@ -550,6 +444,57 @@ impl Implicit {
             settings.max_iterations,
             settings.tolerance
         ))
+    }
+
+    /// Evaluates the Jacobian at `stage` and factors the Newton matrix
+    /// M − γh·(D + γh·K) of stage `s` (`gh` = γh).
+    fn refresh_matrix(
+        &mut self,
+        model: &Model,
+        dynamics: &mut Dynamics,
+        stage: &State,
+        s: usize,
+        gh: f64,
+    ) -> Result<(), String> {
+        dynamics.forces_and_jacobian(model, stage, Mode::Trial, gh, &mut self.jac);
+        self.assemble_matrix(model, stage, gh);
+        if !self.factor() {
+            return Err(format!(
+                "the Newton matrix of SDIRK2 stage {} is singular",
+                s + 1
+            ));
+        }
+        self.refresh = false;
+        self.factored_gh = gh;
+        Ok(())
+    }
+
+    /// Takes back half of the last increment, and asks for a fresh Jacobian.
+    fn halve_increment(&mut self) {
+        for i in 0..self.n {
+            self.step[i] *= 0.5;
+            self.v[i] -= self.step[i];
+        }
+        self.refresh = true;
+    }
+
+    /// Solves for the Newton increment of stage `s` from the residual in
+    /// `rhs` and adds it to the iterate; returns its norm, the largest
+    /// increment relative to |V| + 1.
+    fn increment(&mut self, s: usize) -> Result<f64, String> {
+        if !self.solve() {
+            return Err(format!(
+                "the Newton increment of SDIRK2 stage {} is not finite",
+                s + 1
+            ));
+        }
+        let mut norm = 0.0f64;
+        for i in 0..self.n {
+            self.step[i] = self.rhs[i];
+            self.v[i] += self.rhs[i];
+            norm = norm.max(self.rhs[i].abs() / (self.v[i].abs() + 1.0));
+        }
+        Ok(norm)
     }
 
     /// The largest residual in velocity units (divided by the mass scale),
@@ -759,6 +704,128 @@ impl Implicit {
         );
         self.stats.solves += 1;
         self.rhs.iter().all(|x| x.is_finite())
+    }
+}
+
+/// Whether a Newton iteration whose increment has norm `norm` (contraction
+/// rate `theta` when known) has converged: at once when the increment is a
+/// hundredth of the tolerance, else when the estimated distance to the
+/// solution θ/(1 − θ)·‖Δ‖ is within it.
+fn converged(norm: f64, theta: Option<f64>, tolerance: f64) -> bool {
+    match theta {
+        _ if norm <= 0.01 * tolerance => true,
+        Some(theta) => theta < 1.0 && theta / (1.0 - theta) * norm <= tolerance,
+        None => false,
+    }
+}
+
+/// Per body its first unknown and basis (`None` if not integrated), and the
+/// number of unknowns.
+fn unknowns(model: &Model) -> (Vec<Option<(usize, Basis)>>, usize) {
+    let mut dofs = vec![None; model.bodies.len()];
+    let mut n = 0;
+    for &i in &model.integrated {
+        let basis = match model.bodies[i].motion {
+            Motion::Spin { axis, .. } => Basis::Axis(axis),
+            _ => Basis::Full,
+        };
+        dofs[i] = Some((n, basis));
+        n += basis.dim();
+    }
+    (dofs, n)
+}
+
+/// The mass scale of each unknown: m, the largest principal inertia, or
+/// the spin inertia.
+fn mass_scales(model: &Model, dofs: &[Option<(usize, Basis)>], n: usize) -> Vec<f64> {
+    let mut mass_scale = vec![0.0; n];
+    for &i in &model.integrated {
+        let (off, basis) = dofs[i].expect("integrated");
+        let body = &model.bodies[i];
+        match (basis, body.motion) {
+            (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass_scale[off] = inertia,
+            _ => {
+                let rot = body.inertia.max();
+                mass_scale[off..off + 6]
+                    .copy_from_slice(&[body.mass, body.mass, body.mass, rot, rot, rot]);
+            }
+        }
+    }
+    mass_scale
+}
+
+/// The CSC pattern of Bᵀ(M − h·D)B (column starts and row indices): a
+/// diagonal block per integrated body and a pair of off-diagonal blocks
+/// per coupling of `jac` between two integrated bodies, with where each
+/// block (row body, column body) sits.
+#[allow(clippy::type_complexity)]
+fn block_pattern(
+    model: &Model,
+    dofs: &[Option<(usize, Basis)>],
+    jac: &VelocityJacobian,
+) -> (Vec<usize>, Vec<usize>, BTreeMap<(usize, usize), Block>) {
+    // Row bodies of each column body.
+    let mut rows: BTreeMap<usize, BTreeSet<(usize, usize)>> = BTreeMap::new();
+    for &i in &model.integrated {
+        let (off, _) = dofs[i].expect("integrated");
+        rows.entry(off).or_default().insert((off, i));
+    }
+    for c in &jac.couplings {
+        if let (Some((oa, _)), Some((ob, _))) = (dofs[c.a], dofs[c.b]) {
+            rows.entry(oa).or_default().insert((ob, c.b));
+            rows.entry(ob).or_default().insert((oa, c.a));
+        }
+    }
+    let mut col_ptr = vec![0usize];
+    let mut row_idx = vec![];
+    let mut blocks: BTreeMap<(usize, usize), Block> = BTreeMap::new();
+    for (&col0, row_bodies) in &rows {
+        let j = row_bodies
+            .iter()
+            .find(|&&(o, _)| o == col0)
+            .map(|&(_, j)| j)
+            .expect("diagonal");
+        let width = dofs[j].expect("integrated").1.dim();
+        let mut row_off = 0;
+        let mut pattern = vec![];
+        for &(off, i) in row_bodies {
+            let dim = dofs[i].expect("integrated").1.dim();
+            blocks.insert((i, j), Block { col0, row_off });
+            pattern.extend(off..off + dim);
+            row_off += dim;
+        }
+        for _ in 0..width {
+            row_idx.extend_from_slice(&pattern);
+            col_ptr.push(row_idx.len());
+        }
+    }
+    (col_ptr, row_idx, blocks)
+}
+
+impl Factorization {
+    /// The symbolic LU factorization of the n × n pattern (`col_ptr`,
+    /// `row_idx`), with the scratch of the numeric factorization and solve.
+    fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>) -> Self {
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        // Supernodal: the pattern is made of dense 6×6 blocks; on the
+        // paper scene it factors 3.7 times faster than the simplicial
+        // variant faer picks by default.
+        let params = LuSymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let symbolic = factorize_symbolic_lu(pattern.as_ref(), params)
+            .expect("symbolic LU of the contact pattern");
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        Self {
+            pattern,
+            symbolic,
+            numeric: NumericLu::new(),
+            scratch: Scratch::new(req),
+        }
     }
 }
 

@@ -59,33 +59,37 @@ impl Workspace {
     }
 }
 
-/// Advances `state` by one step of `h` seconds with the model's integrator.
+/// Takes step `n` of the run: advances `state` from t_n = n·dt to
+/// t_{n+1} = (n + 1)·dt with the model's integrator and step dt. The
+/// integrators own time: a step that succeeds ends with `state.t` set to
+/// (n + 1)·dt exactly, so that time does not drift by round-off over a run
+/// (the prescribed motions inside the step are evaluated at t_n + dt).
 ///
 /// An error says why an implicit step could not be solved (the state is then
-/// left at the start of the step). A state that became non-finite is for the
-/// caller to detect.
+/// left at the start of the step, or for SDIRK2 at the end of the last part
+/// step that converged). A state that became non-finite is for the caller to
+/// detect.
 pub fn step(
-    kind: IntegratorKind,
     model: &Model,
     dynamics: &mut Dynamics,
     ws: &mut Workspace,
     state: &mut State,
-    h: f64,
+    n: u64,
 ) -> Result<(), String> {
     fn implicit<'a>(ws: &'a mut Workspace, model: &Model) -> &'a mut implicit::Implicit {
         ws.implicit
             .get_or_insert_with(|| Box::new(implicit::Implicit::new(model)))
     }
-    match kind {
+    let h = model.dt;
+    match model.integrator {
         IntegratorKind::SymplecticEuler => symplectic_euler(model, dynamics, ws, state, h),
         IntegratorKind::Rk4 => rk4(model, dynamics, ws, state, h),
         IntegratorKind::LinearlyImplicitEuler => {
             implicit(ws, model).step(model, dynamics, state, h)
         }
-        IntegratorKind::Sdirk2 => {
-            return implicit(ws, model).sdirk2_step(model, dynamics, state, h);
-        }
+        IntegratorKind::Sdirk2 => implicit(ws, model).sdirk2_step(model, dynamics, state, h)?,
     }
+    state.t = (n + 1) as f64 * h;
     Ok(())
 }
 

@@ -11,12 +11,16 @@ use arrow_array::{
 };
 use arrow_schema::{ArrowError, DataType, Field, Schema};
 
-use crate::record::{ColumnData, ColumnKind, Recording, TableBuffer, columns};
-use crate::scene::TableKind;
+use crate::record::{ColumnData, ColumnKind, Dictionary, Recording, TableBuffer, TableDef};
 
-/// Arrow schema of a table, with `unit` and `description` in each field's metadata.
-pub fn schema(table: TableKind, metadata: HashMap<String, String>) -> Schema {
-    let fields: Vec<Field> = columns(table)
+/// Arrow schema of a table, with `unit` and `description` in each field's
+/// metadata and the table's `ballcage.table` and `ballcage.row` in the
+/// schema's, besides `metadata`.
+pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema {
+    metadata.insert("ballcage.table".to_string(), table.name.to_string());
+    metadata.insert("ballcage.row".to_string(), table.row.to_string());
+    let fields: Vec<Field> = table
+        .columns
         .iter()
         .map(|c| {
             let dt = match c.kind {
@@ -37,16 +41,17 @@ pub fn schema(table: TableKind, metadata: HashMap<String, String>) -> Schema {
 }
 
 /// One record batch per recorded table, with the run metadata on each schema.
-pub fn record_batches(rec: Recording) -> Result<Vec<(TableKind, RecordBatch)>, ArrowError> {
+pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBatch)>, ArrowError> {
     let metadata: HashMap<String, String> = rec.metadata.iter().cloned().collect();
     let dict_values =
         |names: &[String]| -> ArrayRef { Arc::new(StringArray::from_iter_values(names.iter())) };
     let bodies = dict_values(&rec.body_names);
     let pairs = dict_values(&rec.pair_names);
     let mut out = Vec::with_capacity(rec.tables.len());
-    for TableBuffer { kind, data, .. } in rec.tables {
-        let schema = Arc::new(schema(kind, metadata.clone()));
-        let arrays = columns(kind)
+    for TableBuffer { def, data, .. } in rec.tables {
+        let schema = Arc::new(schema(def, metadata.clone()));
+        let arrays = def
+            .columns
             .iter()
             .zip(data)
             .map(|(c, d)| -> Result<ArrayRef, ArrowError> {
@@ -56,8 +61,8 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(TableKind, RecordBatch)>, A
                     (ColumnKind::F64, ColumnData::F64(v)) => Arc::new(Float64Array::from(v)),
                     (ColumnKind::Name(dict), ColumnData::U32(v)) => {
                         let values = match dict {
-                            crate::record::Dictionary::Bodies => bodies.clone(),
-                            crate::record::Dictionary::Pairs => pairs.clone(),
+                            Dictionary::Bodies => bodies.clone(),
+                            Dictionary::Pairs => pairs.clone(),
                         };
                         Arc::new(DictionaryArray::<UInt32Type>::try_new(
                             UInt32Array::from(v),
@@ -73,7 +78,7 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(TableKind, RecordBatch)>, A
                 })
             })
             .collect::<Result<Vec<_>, _>>()?;
-        out.push((kind, RecordBatch::try_new(schema, arrays)?));
+        out.push((def, RecordBatch::try_new(schema, arrays)?));
     }
     Ok(out)
 }

@@ -1,9 +1,18 @@
-//! What gets kept: the column definitions of every output table (the one
-//! schema of the project) and columnar buffers filled once per frame.
+//! What gets kept: the column definitions of the engine's output tables
+//! (the one schema of the project), columnar buffers filled once per frame,
+//! and the [`Observer`] interface through which a layer above the engine
+//! (the drill pipe) adds tables of its own.
+//!
+//! A table is a [`TableDef`]: a name and its columns, each with type, unit and
+//! meaning. The engine's own tables are [`BODIES`], [`CONTACTS`], [`ENERGY`]
+//! and [`SUMMARY`]; the output stage turns any `TableDef` into an Arrow
+//! schema, so a table is defined once, wherever it is produced.
 
 mod frame;
+mod observer;
 
 pub use frame::Recorder;
+pub use observer::{Frame, Observer, contact_totals};
 
 use crate::scene::TableKind;
 
@@ -42,7 +51,19 @@ pub struct ColumnDef {
     pub description: &'static str,
 }
 
-const fn col(
+/// An output table: its name (also the Parquet file stem) and its columns.
+#[derive(Debug, PartialEq, Eq)]
+pub struct TableDef {
+    /// Table name.
+    pub name: &'static str,
+    /// What one row is.
+    pub row: &'static str,
+    /// Columns, in order.
+    pub columns: &'static [ColumnDef],
+}
+
+/// A column definition (for `const` tables).
+pub const fn col(
     name: &'static str,
     kind: ColumnKind,
     unit: &'static str,
@@ -58,11 +79,13 @@ const fn col(
 
 use ColumnKind::{F64, Name, U32, U64};
 
-const STEP: ColumnDef = col("step", U64, "", "integrator step index of the frame");
-const TIME: ColumnDef = col("t", F64, "s", "simulated time");
+/// The frame's integrator step index, first column of every per-frame table.
+pub const STEP: ColumnDef = col("step", U64, "", "integrator step index of the frame");
+/// The frame's simulated time, second column of every per-frame table.
+pub const TIME: ColumnDef = col("t", F64, "s", "simulated time");
 
 /// Columns of the `bodies` table: one row per recorded body per frame.
-pub const BODIES: &[ColumnDef] = &[
+const BODIES_COLUMNS: &[ColumnDef] = &[
     STEP,
     TIME,
     col("body_id", U32, "", "body index in the scene's body list"),
@@ -103,7 +126,7 @@ pub const BODIES: &[ColumnDef] = &[
 ];
 
 /// Columns of the `contacts` table: one row per contact point in contact per frame.
-pub const CONTACTS: &[ColumnDef] = &[
+const CONTACTS_COLUMNS: &[ColumnDef] = &[
     STEP,
     TIME,
     col(
@@ -197,7 +220,7 @@ pub const CONTACTS: &[ColumnDef] = &[
 ];
 
 /// Columns of the `energy` table: one row per frame.
-pub const ENERGY: &[ColumnDef] = &[
+const ENERGY_COLUMNS: &[ColumnDef] = &[
     STEP,
     TIME,
     col(
@@ -227,7 +250,7 @@ pub const ENERGY: &[ColumnDef] = &[
 ];
 
 /// Columns of the `summary` table: one row per contact pair.
-pub const SUMMARY: &[ColumnDef] = &[
+const SUMMARY_COLUMNS: &[ColumnDef] = &[
     col(
         "pair_id",
         U32,
@@ -276,177 +299,38 @@ pub const SUMMARY: &[ColumnDef] = &[
     ),
 ];
 
-/// Columns of the `links` table (drill pipe): one row per link per frame.
-pub const LINKS: &[ColumnDef] = &[
-    STEP,
-    TIME,
-    col(
-        "link",
-        U32,
-        "",
-        "link number, 1 at the top (the paper's joint number)",
-    ),
-    col("body", Name(Dictionary::Bodies), "", "body name"),
-    col(
-        "inclination_deg",
-        F64,
-        "deg",
-        "eq. (4) φ: angle of the link axis from the downward vertical",
-    ),
-    col(
-        "azimuth_deg",
-        F64,
-        "deg",
-        "eq. (4) θ: azimuth of the link axis about the vertical, from the bend direction (+x)",
-    ),
-    col("com_x", F64, "m", "centre of mass x, world frame"),
-    col("com_y", F64, "m", "centre of mass y, world frame"),
-    col("com_z", F64, "m", "centre of mass z, world frame"),
-    col(
-        "radial_offset",
-        F64,
-        "m",
-        "distance of the centre of mass from the tube centreline (extended straight past the arc)",
-    ),
-    col(
-        "included_angle_deg",
-        F64,
-        "deg",
-        "angle between this link's axis and the next body's, 180 when straight",
-    ),
-];
+/// The `bodies` table.
+pub const BODIES: TableDef = TableDef {
+    name: "bodies",
+    row: "one row per recorded body per frame",
+    columns: BODIES_COLUMNS,
+};
+/// The `contacts` table.
+pub const CONTACTS: TableDef = TableDef {
+    name: "contacts",
+    row: "one row per contact point in contact per frame",
+    columns: CONTACTS_COLUMNS,
+};
+/// The `energy` table.
+pub const ENERGY: TableDef = TableDef {
+    name: "energy",
+    row: "one row per frame",
+    columns: ENERGY_COLUMNS,
+};
+/// The `summary` table.
+pub const SUMMARY: TableDef = TableDef {
+    name: "summary",
+    row: "one row per contact pair",
+    columns: SUMMARY_COLUMNS,
+};
 
-/// Columns of the `hinges` table (drill pipe): one row per hinge per frame.
-pub const HINGES: &[ColumnDef] = &[
-    STEP,
-    TIME,
-    col(
-        "hinge",
-        U32,
-        "",
-        "hinge number, 0 between the upper connector and link 1",
-    ),
-    col("bend_deg", F64, "deg", "angle between the two bodies' axes"),
-    col(
-        "cage_head_normal",
-        F64,
-        "N",
-        "normal force between cage and ball head",
-    ),
-    col(
-        "cage_head_tangential",
-        F64,
-        "N",
-        "friction force magnitude between cage and ball head",
-    ),
-    col(
-        "cage_seat_normal",
-        F64,
-        "N",
-        "normal force between cage and ball seat",
-    ),
-    col(
-        "cage_seat_tangential",
-        F64,
-        "N",
-        "friction force magnitude between cage and ball seat",
-    ),
-];
-
-/// Columns of the `keys` table (drill pipe): one row per ball key per frame.
-/// Race forces add both Gothic-arch flanks; window forces both window pairs.
-pub const KEYS: &[ColumnDef] = &[
-    STEP,
-    TIME,
-    col("hinge", U32, "", "hinge number"),
-    col("key", U32, "", "ball key number, 0–5 around the joint"),
-    col(
-        "inner_normal",
-        F64,
-        "N",
-        "normal force on the inner race (ball head grooves), both flanks",
-    ),
-    col(
-        "inner_tangential",
-        F64,
-        "N",
-        "friction force magnitude on the inner race",
-    ),
-    col(
-        "outer_normal",
-        F64,
-        "N",
-        "normal force on the outer race (ball seat grooves), both flanks",
-    ),
-    col(
-        "outer_tangential",
-        F64,
-        "N",
-        "friction force magnitude on the outer race",
-    ),
-    col(
-        "window_normal",
-        F64,
-        "N",
-        "normal force on the cage window faces",
-    ),
-    col(
-        "window_tangential",
-        F64,
-        "N",
-        "friction force magnitude on the cage window faces",
-    ),
-];
-
-/// Columns of the `drive` table (drill pipe): one row per frame.
-pub const DRIVE: &[ColumnDef] = &[
-    STEP,
-    TIME,
-    col(
-        "input_speed",
-        F64,
-        "rad/s",
-        "prescribed spin speed of the upper connector",
-    ),
-    col(
-        "input_torque",
-        F64,
-        "N*m",
-        "torque the drive applies to the upper connector about its axis",
-    ),
-    col(
-        "output_speed",
-        F64,
-        "rad/s",
-        "spin speed of the lower connector",
-    ),
-    col(
-        "output_torque",
-        F64,
-        "N*m",
-        "resisting moment applied to the lower connector (opposing its spin)",
-    ),
-    col("input_power", F64, "W", "input_torque × input_speed"),
-    col("output_power", F64, "W", "output_torque × output_speed"),
-    col(
-        "efficiency",
-        F64,
-        "1",
-        "output_power / input_power; 0 while the input power is not positive",
-    ),
-];
-
-/// The columns of a table.
-pub fn columns(table: TableKind) -> &'static [ColumnDef] {
-    match table {
-        TableKind::Bodies => BODIES,
-        TableKind::Contacts => CONTACTS,
-        TableKind::Energy => ENERGY,
-        TableKind::Summary => SUMMARY,
-        TableKind::Links => LINKS,
-        TableKind::Hinges => HINGES,
-        TableKind::Keys => KEYS,
-        TableKind::Drive => DRIVE,
+/// The definition of an engine table.
+pub fn table_def(kind: TableKind) -> &'static TableDef {
+    match kind {
+        TableKind::Bodies => &BODIES,
+        TableKind::Contacts => &CONTACTS,
+        TableKind::Energy => &ENERGY,
+        TableKind::Summary => &SUMMARY,
     }
 }
 
@@ -476,17 +360,18 @@ pub enum ColumnData {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TableBuffer {
     /// Which table.
-    pub kind: TableKind,
-    /// One buffer per column of [`columns`]`(kind)`, in order.
+    pub def: &'static TableDef,
+    /// One buffer per column of `def.columns`, in order.
     pub data: Vec<ColumnData>,
     /// Number of rows.
     pub rows: usize,
 }
 
 impl TableBuffer {
-    /// Empty buffers for `kind`.
-    pub fn new(kind: TableKind) -> Self {
-        let data = columns(kind)
+    /// Empty buffers for the table `def`.
+    pub fn new(def: &'static TableDef) -> Self {
+        let data = def
+            .columns
             .iter()
             .map(|c| match c.kind {
                 U64 => ColumnData::U64(Vec::new()),
@@ -494,11 +379,13 @@ impl TableBuffer {
                 F64 => ColumnData::F64(Vec::new()),
             })
             .collect();
-        Self {
-            kind,
-            data,
-            rows: 0,
-        }
+        Self { def, data, rows: 0 }
+    }
+
+    /// The buffer of the column named `name`, if the table has one.
+    pub fn column(&self, name: &str) -> Option<&ColumnData> {
+        let i = self.def.columns.iter().position(|c| c.name == name)?;
+        self.data.get(i)
     }
 
     /// Appends a row; `row` follows the column order of the table.
@@ -506,8 +393,8 @@ impl TableBuffer {
         debug_assert_eq!(
             row.len(),
             self.data.len(),
-            "row width of table {:?}",
-            self.kind
+            "row width of table {}",
+            self.def.name
         );
         for (d, v) in self.data.iter_mut().zip(row) {
             match (d, v) {
@@ -515,8 +402,8 @@ impl TableBuffer {
                 (ColumnData::U32(d), Cell::U32(v)) => d.push(*v),
                 (ColumnData::F64(d), Cell::F64(v)) => d.push(*v),
                 (d, v) => panic!(
-                    "cell {v:?} does not fit column {d:?} of table {:?}",
-                    self.kind
+                    "cell {v:?} does not fit column {d:?} of table {}",
+                    self.def.name
                 ),
             }
         }
@@ -527,7 +414,7 @@ impl TableBuffer {
 /// All tables of a run plus the names the dictionary columns index.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
-    /// Recorded tables, in the scene's order.
+    /// Recorded tables: the engine's in the scene's order, then the observers'.
     pub tables: Vec<TableBuffer>,
     /// Body names by id.
     pub body_names: Vec<String>,
@@ -551,15 +438,18 @@ impl Recording {
 mod tests {
     use super::*;
 
+    const ENGINE: [&TableDef; 4] = [&BODIES, &CONTACTS, &ENERGY, &SUMMARY];
+
     #[test]
     fn column_names_are_unique_within_each_table() {
-        for t in TableKind::ALL {
-            let cols = columns(t);
+        for t in ENGINE {
+            let cols = t.columns;
             for (i, c) in cols.iter().enumerate() {
                 assert!(
                     cols[..i].iter().all(|o| o.name != c.name),
-                    "{} repeated in {t:?}",
-                    c.name
+                    "{} repeated in {}",
+                    c.name,
+                    t.name
                 );
             }
         }
@@ -567,12 +457,19 @@ mod tests {
 
     #[test]
     fn every_float_column_states_a_unit() {
-        for t in TableKind::ALL {
-            for c in columns(t) {
+        for t in ENGINE {
+            for c in t.columns {
                 if c.kind == F64 {
                     assert!(!c.unit.is_empty(), "{} has no unit", c.name);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn every_engine_table_kind_has_its_definition() {
+        for k in TableKind::ALL {
+            assert_eq!(table_def(k).name, k.name());
         }
     }
 }

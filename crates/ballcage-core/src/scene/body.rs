@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{direction, finite_vec, non_negative, positive};
+use super::{Scene, direction, finite_vec, non_negative, positive};
 use crate::error::SceneError;
 
 /// How a body moves.
@@ -187,30 +187,34 @@ impl ShapeSpec {
                     ));
                 }
                 for (i, s) in segments.iter().enumerate() {
-                    let p = format!("{path}.segments[{i}]");
-                    match s {
-                        TubeSegmentSpec::Straight { length } => {
-                            positive(&format!("{p}.length"), *length)?
-                        }
-                        TubeSegmentSpec::Arc {
-                            radius,
-                            angle_deg,
-                            bend,
-                        } => {
-                            positive(&format!("{p}.radius"), *radius)?;
-                            positive(&format!("{p}.angle_deg"), *angle_deg)?;
-                            if *angle_deg >= 360.0 {
-                                return Err(SceneError::new(
-                                    format!("{p}.angle_deg"),
-                                    angle_deg,
-                                    "must be below 360",
-                                ));
-                            }
-                            direction(&format!("{p}.bend"), bend)?;
-                        }
-                    }
+                    s.validate(&format!("{path}.segments[{i}]"))?;
                 }
                 Ok(())
+            }
+        }
+    }
+}
+
+impl TubeSegmentSpec {
+    /// Checks lengths, radii and angles.
+    fn validate(&self, p: &str) -> Result<(), SceneError> {
+        match self {
+            Self::Straight { length } => positive(&format!("{p}.length"), *length),
+            Self::Arc {
+                radius,
+                angle_deg,
+                bend,
+            } => {
+                positive(&format!("{p}.radius"), *radius)?;
+                positive(&format!("{p}.angle_deg"), *angle_deg)?;
+                if *angle_deg >= 360.0 {
+                    return Err(SceneError::new(
+                        format!("{p}.angle_deg"),
+                        angle_deg,
+                        "must be below 360",
+                    ));
+                }
+                direction(&format!("{p}.bend"), bend)
             }
         }
     }
@@ -290,6 +294,7 @@ impl BodySpec {
         Some((m, i1.map(|x| x * m / m1)))
     }
 
+    /// Checks every field; the first problem found is returned with its path.
     pub(super) fn validate(&self, path: &str) -> Result<(), SceneError> {
         if self.name.trim().is_empty() {
             return Err(SceneError::new(
@@ -299,6 +304,13 @@ impl BodySpec {
             ));
         }
         self.shape.validate(&format!("{path}.shape"))?;
+        self.validate_initial_state(path)?;
+        self.validate_mass(path)?;
+        self.validate_motion(path)
+    }
+
+    /// Initial pose and velocities: finite, the orientation a unit quaternion.
+    fn validate_initial_state(&self, path: &str) -> Result<(), SceneError> {
         finite_vec(&format!("{path}.position"), &self.position)?;
         finite_vec(&format!("{path}.orientation"), &self.orientation)?;
         let qn = self.orientation.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -310,7 +322,12 @@ impl BodySpec {
             ));
         }
         finite_vec(&format!("{path}.velocity"), &self.velocity)?;
-        finite_vec(&format!("{path}.angular_velocity"), &self.angular_velocity)?;
+        finite_vec(&format!("{path}.angular_velocity"), &self.angular_velocity)
+    }
+
+    /// Mass, density and inertia: positive, consistent with each other and
+    /// with the shape.
+    fn validate_mass(&self, path: &str) -> Result<(), SceneError> {
         if let Some(m) = self.mass {
             positive(&format!("{path}.mass"), m)?;
         }
@@ -358,6 +375,12 @@ impl BodySpec {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// What the motion needs: mass properties and no initial velocity
+    /// unless integrated, a spin axis (and only then) for the spin motions.
+    fn validate_motion(&self, path: &str) -> Result<(), SceneError> {
         if self.is_integrated() {
             if self.mass.is_none() && self.density.is_none() {
                 return Err(SceneError::new(
@@ -394,18 +417,24 @@ impl BodySpec {
                 };
                 direction(&format!("{path}.spin_axis"), axis)?;
                 super::finite(&format!("{path}.spin_speed"), self.spin_speed)?;
-                non_negative(&format!("{path}.spin_ramp"), self.spin_ramp)?;
+                non_negative(&format!("{path}.spin_ramp"), self.spin_ramp)
             }
-            _ => {
-                if self.spin_axis.is_some() {
-                    return Err(SceneError::new(
-                        format!("{path}.spin_axis"),
-                        format!("{:?}", self.spin_axis.unwrap_or_default()),
-                        "only `kinematic-spin` and `spin` bodies take a spin axis",
-                    ));
-                }
-            }
+            _ if self.spin_axis.is_some() => Err(SceneError::new(
+                format!("{path}.spin_axis"),
+                format!("{:?}", self.spin_axis.unwrap_or_default()),
+                "only `kinematic-spin` and `spin` bodies take a spin axis",
+            )),
+            _ => Ok(()),
         }
-        Ok(())
+    }
+}
+
+impl Scene {
+    /// Id of the body named `name`; else the error "no body of that name"
+    /// at `path`, the field that names it. The one name lookup of scenes
+    /// and assembly.
+    pub fn body_id(&self, path: &str, name: &str) -> Result<usize, SceneError> {
+        self.body_index(name)
+            .ok_or_else(|| SceneError::new(path, name, "no body of that name"))
     }
 }

@@ -1,15 +1,11 @@
-//! Contact pair declarations and their force laws.
+//! Contact pair declarations and their force laws, as written: the laws
+//! and geometry the engine evaluates are built from them at assembly,
+//! which also converts the field units.
 
 use serde::{Deserialize, Serialize};
 
-use super::{Scene, ShapeSpec, direction, finite_vec, non_negative, positive};
+use super::{Scene, direction, finite_vec, non_negative, positive};
 use crate::error::SceneError;
-use crate::force::{
-    AdamsFrictionParams, DissipativeLaw, DissipativeParams, FrictionLaw, HertzParams, ImpactParams,
-    LinearParams, NormalLaw, TanhFrictionParams,
-};
-use crate::geometry::PairGeometry;
-use crate::math::Vec3;
 
 /// Units in which a law's parameters are written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -19,19 +15,9 @@ pub enum FieldUnits {
     #[serde(rename = "SI")]
     Si,
     /// The paper's (and MSC Adams') field units: stiffness N/mm^n, damping
-    /// N·s/mm, lengths mm, speeds mm/s. Converted to SI once, on reading.
+    /// N·s/mm, lengths mm, speeds mm/s. Converted to SI once, at assembly.
     #[serde(rename = "N-mm-s")]
     NMmS,
-}
-
-impl FieldUnits {
-    /// Metres per length unit.
-    fn length(self) -> f64 {
-        match self {
-            Self::Si => 1.0,
-            Self::NMmS => 1e-3,
-        }
-    }
 }
 
 fn default_exponent_hertzian() -> f64 {
@@ -130,133 +116,89 @@ pub enum NormalLawSpec {
 }
 
 impl NormalLawSpec {
-    /// Validates and converts to the SI law the engine evaluates.
-    pub fn to_law(&self, path: &str) -> Result<NormalLaw, SceneError> {
-        let exponent_ok = |n: f64| -> Result<(), SceneError> {
-            positive(&format!("{path}.exponent"), n)?;
-            if n < 1.0 {
-                return Err(SceneError::new(
-                    format!("{path}.exponent"),
-                    n,
-                    "must be at least 1 (the force must start at zero slope or higher)",
-                ));
-            }
-            Ok(())
-        };
-        let restitution_ok = |e: f64| -> Result<(), SceneError> {
-            positive(&format!("{path}.restitution"), e)?;
-            if e > 1.0 {
-                return Err(SceneError::new(
-                    format!("{path}.restitution"),
-                    e,
-                    "must lie in (0, 1]",
-                ));
-            }
-            Ok(())
-        };
-        let stiff = |k: f64, n: f64, u: FieldUnits| -> Result<f64, SceneError> {
-            positive(&format!("{path}.stiffness"), k)?;
-            // N/mm^n → N/m^n: F = K δ_mm^n = K (δ_m / L)^n with L the unit length in m.
-            Ok(k * u.length().powf(-n))
-        };
-        let dissipative =
-            |law, k: f64, n: f64, e: f64, v: f64, u: FieldUnits| -> Result<NormalLaw, SceneError> {
-                exponent_ok(n)?;
-                restitution_ok(e)?;
-                positive(&format!("{path}.min_approach_speed"), v)?;
-                Ok(NormalLaw::Dissipative(
-                    law,
-                    DissipativeParams {
-                        stiffness: stiff(k, n, u)?,
-                        exponent: n,
-                        restitution: e,
-                        min_approach_speed: v * u.length(),
-                    },
-                ))
-            };
+    /// Checks the parameters' ranges (in the units written).
+    pub fn validate(&self, path: &str) -> Result<(), SceneError> {
+        let exponent = |n: f64| exponent_at_least_one(&format!("{path}.exponent"), n);
+        let stiffness = |k: f64| positive(&format!("{path}.stiffness"), k);
         match *self {
             Self::Impact {
-                stiffness,
-                exponent,
+                stiffness: k,
+                exponent: n,
                 damping,
                 depth_max,
-                units,
+                ..
             } => {
-                exponent_ok(exponent)?;
+                exponent(n)?;
                 non_negative(&format!("{path}.damping"), damping)?;
                 positive(&format!("{path}.depth_max"), depth_max)?;
-                Ok(NormalLaw::Impact(ImpactParams {
-                    stiffness: stiff(stiffness, exponent, units)?,
-                    exponent,
-                    damping: damping / units.length(),
-                    depth_max: depth_max * units.length(),
-                }))
+                stiffness(k)
             }
             Self::LankaraniNikravesh {
-                stiffness,
-                exponent,
+                stiffness: k,
+                exponent: n,
                 restitution,
                 min_approach_speed,
-                units,
-            } => dissipative(
-                DissipativeLaw::LankaraniNikravesh,
-                stiffness,
-                exponent,
+                ..
+            }
+            | Self::HuntCrossley {
+                stiffness: k,
+                exponent: n,
                 restitution,
                 min_approach_speed,
-                units,
-            ),
-            Self::HuntCrossley {
-                stiffness,
-                exponent,
+                ..
+            }
+            | Self::Flores {
+                stiffness: k,
+                exponent: n,
                 restitution,
                 min_approach_speed,
-                units,
-            } => dissipative(
-                DissipativeLaw::HuntCrossley,
-                stiffness,
-                exponent,
-                restitution,
-                min_approach_speed,
-                units,
-            ),
-            Self::Flores {
-                stiffness,
-                exponent,
-                restitution,
-                min_approach_speed,
-                units,
-            } => dissipative(
-                DissipativeLaw::Flores,
-                stiffness,
-                exponent,
-                restitution,
-                min_approach_speed,
-                units,
-            ),
-            Self::Hertz { stiffness, units } => Ok(NormalLaw::Hertz(HertzParams {
-                stiffness: stiff(stiffness, 1.5, units)?,
-            })),
+                ..
+            } => {
+                exponent(n)?;
+                restitution_in_range(&format!("{path}.restitution"), restitution)?;
+                positive(&format!("{path}.min_approach_speed"), min_approach_speed)?;
+                stiffness(k)
+            }
+            Self::Hertz { stiffness: k, .. } => stiffness(k),
             Self::Linear {
-                stiffness,
+                stiffness: k,
                 damping,
-                units,
+                ..
             } => {
                 non_negative(&format!("{path}.damping"), damping)?;
-                Ok(NormalLaw::Linear(LinearParams {
-                    stiffness: stiff(stiffness, 1.0, units)?,
-                    damping: damping / units.length(),
-                }))
+                stiffness(k)
             }
         }
     }
+}
+
+/// A force exponent: positive and at least 1.
+fn exponent_at_least_one(path: &str, n: f64) -> Result<(), SceneError> {
+    positive(path, n)?;
+    if n < 1.0 {
+        return Err(SceneError::new(
+            path,
+            n,
+            "must be at least 1 (the force must start at zero slope or higher)",
+        ));
+    }
+    Ok(())
+}
+
+/// A coefficient of restitution: in (0, 1].
+fn restitution_in_range(path: &str, e: f64) -> Result<(), SceneError> {
+    positive(path, e)?;
+    if e > 1.0 {
+        return Err(SceneError::new(path, e, "must lie in (0, 1]"));
+    }
+    Ok(())
 }
 
 /// Friction law of a pair. `law` selects the variant.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "law", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum FrictionLawSpec {
-    /// MSC Adams static/dynamic law (physics.md §2.2), no true stiction.
+    /// MSC Adams static/dynamic law (docs/model.md §2.2), no true stiction.
     Adams {
         /// μs [-].
         mu_static: f64,
@@ -283,15 +225,15 @@ pub enum FrictionLawSpec {
 }
 
 impl FrictionLawSpec {
-    /// Validates and converts to the SI law the engine evaluates.
-    pub fn to_law(&self, path: &str) -> Result<FrictionLaw, SceneError> {
+    /// Checks the parameters' ranges (in the units written).
+    pub fn validate(&self, path: &str) -> Result<(), SceneError> {
         match *self {
             Self::Adams {
                 mu_static,
                 mu_dynamic,
                 v_static,
                 v_dynamic,
-                units,
+                ..
             } => {
                 non_negative(&format!("{path}.mu_static"), mu_static)?;
                 non_negative(&format!("{path}.mu_dynamic"), mu_dynamic)?;
@@ -304,21 +246,11 @@ impl FrictionLawSpec {
                         format!("must exceed v_static = {v_static}"),
                     ));
                 }
-                let l = units.length();
-                Ok(FrictionLaw::Adams(AdamsFrictionParams {
-                    mu_static,
-                    mu_dynamic,
-                    v_static: v_static * l,
-                    v_dynamic: v_dynamic * l,
-                }))
+                Ok(())
             }
-            Self::Tanh { mu, v_ref, units } => {
+            Self::Tanh { mu, v_ref, .. } => {
                 non_negative(&format!("{path}.mu"), mu)?;
-                positive(&format!("{path}.v_ref"), v_ref)?;
-                Ok(FrictionLaw::Tanh(TanhFrictionParams {
-                    mu,
-                    v_ref: v_ref * units.length(),
-                }))
+                positive(&format!("{path}.v_ref"), v_ref)
             }
         }
     }
@@ -367,6 +299,54 @@ pub enum FeatureSpec {
     },
 }
 
+impl FeatureSpec {
+    /// Checks the feature's own dimensions; whether it fits the pair's
+    /// shapes is checked at assembly.
+    pub fn validate(&self, g: &str) -> Result<(), SceneError> {
+        match self {
+            Self::TorusBall {
+                centre,
+                axis,
+                core_radius,
+                tube_radius,
+            } => {
+                finite_vec(&format!("{g}.centre"), centre)?;
+                direction(&format!("{g}.axis"), axis)?;
+                positive(&format!("{g}.core_radius"), *core_radius)?;
+                positive(&format!("{g}.tube_radius"), *tube_radius)
+            }
+            Self::SlotBall {
+                centre,
+                normal,
+                half_width,
+            } => {
+                finite_vec(&format!("{g}.centre"), centre)?;
+                direction(&format!("{g}.normal"), normal)?;
+                positive(&format!("{g}.half_width"), *half_width)
+            }
+            Self::CavitySphere {
+                cavity_centre,
+                cavity_radius,
+                sphere_centre,
+                sphere_radius,
+            } => {
+                finite_vec(&format!("{g}.cavity_centre"), cavity_centre)?;
+                finite_vec(&format!("{g}.sphere_centre"), sphere_centre)?;
+                positive(&format!("{g}.cavity_radius"), *cavity_radius)?;
+                positive(&format!("{g}.sphere_radius"), *sphere_radius)?;
+                if sphere_radius >= cavity_radius {
+                    return Err(SceneError::new(
+                        format!("{g}.sphere_radius"),
+                        sphere_radius,
+                        format!("must be smaller than cavity_radius = {cavity_radius}"),
+                    ));
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 /// A pair of bodies that may touch, and the laws of their contact.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -403,130 +383,9 @@ impl ContactSpec {
             .unwrap_or_else(|| format!("{}/{}", self.bodies[0], self.bodies[1]))
     }
 
-    /// The point finder of this pair, and whether the canonical order is (b, a).
-    pub fn resolve_geometry(
-        &self,
-        path: &str,
-        scene: &Scene,
-    ) -> Result<(PairGeometry, bool), SceneError> {
-        let mut idx = [0usize; 2];
-        for (k, name) in self.bodies.iter().enumerate() {
-            idx[k] = scene.body_index(name).ok_or_else(|| {
-                SceneError::new(format!("{path}.bodies[{k}]"), name, "no body of that name")
-            })?;
-        }
-        if idx[0] == idx[1] {
-            return Err(SceneError::new(
-                format!("{path}.bodies"),
-                format!("{:?}", self.bodies),
-                "a body cannot touch itself",
-            ));
-        }
-        let (sa, sb) = (&scene.bodies[idx[0]].shape, &scene.bodies[idx[1]].shape);
-        let Some(feature) = &self.geometry else {
-            return PairGeometry::select(sa, sb, self.points).ok_or_else(|| {
-                SceneError::new(
-                    format!("{path}.bodies"),
-                    format!("{:?}", self.bodies),
-                    format!(
-                        "no contact geometry for a {}–{} pair (supported: {}; or give `geometry`)",
-                        sa.kind_name(),
-                        sb.kind_name(),
-                        PairGeometry::SUPPORTED
-                    ),
-                )
-            });
-        };
-        let g = format!("{path}.geometry");
-        let ball_radius = || match sb {
-            ShapeSpec::Ball { radius } => Ok(*radius),
-            other => Err(SceneError::new(
-                format!("{path}.bodies[1]"),
-                &self.bodies[1],
-                format!(
-                    "this geometry needs body b to be a ball, not a {}",
-                    other.kind_name()
-                ),
-            )),
-        };
-        let geometry = match feature {
-            FeatureSpec::TorusBall {
-                centre,
-                axis,
-                core_radius,
-                tube_radius,
-            } => {
-                finite_vec(&format!("{g}.centre"), centre)?;
-                direction(&format!("{g}.axis"), axis)?;
-                positive(&format!("{g}.core_radius"), *core_radius)?;
-                positive(&format!("{g}.tube_radius"), *tube_radius)?;
-                let r = ball_radius()?;
-                if r >= *tube_radius {
-                    return Err(SceneError::new(
-                        format!("{g}.tube_radius"),
-                        tube_radius,
-                        format!("must exceed the ball radius {r}"),
-                    ));
-                }
-                PairGeometry::TorusBall {
-                    centre: Vec3::from(*centre),
-                    axis: Vec3::from(*axis).normalize(),
-                    core_radius: *core_radius,
-                    tube_radius: *tube_radius,
-                    ball_radius: r,
-                }
-            }
-            FeatureSpec::SlotBall {
-                centre,
-                normal,
-                half_width,
-            } => {
-                finite_vec(&format!("{g}.centre"), centre)?;
-                direction(&format!("{g}.normal"), normal)?;
-                positive(&format!("{g}.half_width"), *half_width)?;
-                let r = ball_radius()?;
-                if r >= *half_width {
-                    return Err(SceneError::new(
-                        format!("{g}.half_width"),
-                        half_width,
-                        format!("must exceed the ball radius {r}"),
-                    ));
-                }
-                PairGeometry::SlotBall {
-                    centre: Vec3::from(*centre),
-                    normal: Vec3::from(*normal).normalize(),
-                    half_width: *half_width,
-                    ball_radius: r,
-                }
-            }
-            FeatureSpec::CavitySphere {
-                cavity_centre,
-                cavity_radius,
-                sphere_centre,
-                sphere_radius,
-            } => {
-                finite_vec(&format!("{g}.cavity_centre"), cavity_centre)?;
-                finite_vec(&format!("{g}.sphere_centre"), sphere_centre)?;
-                positive(&format!("{g}.cavity_radius"), *cavity_radius)?;
-                positive(&format!("{g}.sphere_radius"), *sphere_radius)?;
-                if sphere_radius >= cavity_radius {
-                    return Err(SceneError::new(
-                        format!("{g}.sphere_radius"),
-                        sphere_radius,
-                        format!("must be smaller than cavity_radius = {cavity_radius}"),
-                    ));
-                }
-                PairGeometry::CavitySphere {
-                    cavity_centre: Vec3::from(*cavity_centre),
-                    cavity_radius: *cavity_radius,
-                    sphere_centre: Vec3::from(*sphere_centre),
-                    sphere_radius: *sphere_radius,
-                }
-            }
-        };
-        Ok((geometry, false))
-    }
-
+    /// Checks the sample count, the bodies (existing, two), the feature's
+    /// dimensions and the laws' parameters. Whether the geometry fits the
+    /// bodies' shapes is checked at assembly.
     pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
         if !(2..=64).contains(&self.points) {
             return Err(SceneError::new(
@@ -535,10 +394,23 @@ impl ContactSpec {
                 "must lie in 2..=64 (2 = both end rims)",
             ));
         }
-        self.resolve_geometry(path, scene)?;
-        self.normal.to_law(&format!("{path}.normal"))?;
+        let mut idx = [0usize; 2];
+        for (k, name) in self.bodies.iter().enumerate() {
+            idx[k] = scene.body_id(&format!("{path}.bodies[{k}]"), name)?;
+        }
+        if idx[0] == idx[1] {
+            return Err(SceneError::new(
+                format!("{path}.bodies"),
+                format!("{:?}", self.bodies),
+                "a body cannot touch itself",
+            ));
+        }
+        if let Some(feature) = &self.geometry {
+            feature.validate(&format!("{path}.geometry"))?;
+        }
+        self.normal.validate(&format!("{path}.normal"))?;
         if let Some(f) = &self.friction {
-            f.to_law(&format!("{path}.friction"))?;
+            f.validate(&format!("{path}.friction"))?;
         }
         Ok(())
     }

@@ -56,13 +56,12 @@ impl JointSpec {
         }
     }
 
+    /// Checks the bodies (two, existing, one of them moving) and the parameters.
     pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
         let bodies = self.bodies();
         let mut idx = [0usize; 2];
         for (k, name) in bodies.iter().enumerate() {
-            idx[k] = scene.body_index(name).ok_or_else(|| {
-                SceneError::new(format!("{path}.bodies[{k}]"), name, "no body of that name")
-            })?;
+            idx[k] = scene.body_id(&format!("{path}.bodies[{k}]"), name)?;
         }
         if idx[0] == idx[1] {
             return Err(SceneError::new(

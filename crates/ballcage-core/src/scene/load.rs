@@ -2,9 +2,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Scene, direction, finite, non_negative};
+use super::{MotionKind, Scene, direction, finite, non_negative};
 use crate::error::SceneError;
-use crate::scene::MotionKind;
 
 /// An applied load. `type` selects the variant.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -27,6 +26,7 @@ pub enum LoadSpec {
 }
 
 impl LoadSpec {
+    /// Checks the body (existing and integrated) and the torque.
     pub(super) fn validate(&self, path: &str, scene: &Scene) -> Result<(), SceneError> {
         match self {
             Self::Torque {
@@ -35,13 +35,7 @@ impl LoadSpec {
                 magnitude,
                 ramp,
             } => {
-                let Some(i) = scene.body_index(body) else {
-                    return Err(SceneError::new(
-                        format!("{path}.body"),
-                        body,
-                        "no body of that name",
-                    ));
-                };
+                let i = scene.body_id(&format!("{path}.body"), body)?;
                 if !scene.bodies[i].is_integrated() {
                     return Err(SceneError::new(
                         format!("{path}.body"),

@@ -5,7 +5,7 @@
 //! validated here, in one place. Every error names the field
 //! ([`SceneError::path`]). All quantities are SI unless a field says otherwise;
 //! the only non-SI input is a normal law declared with `units = "N-mm-s"`
-//! (the paper's field units), converted once in [`NormalLawSpec::to_law`].
+//! (the paper's field units), converted once when the scene is assembled.
 
 mod body;
 mod contact;
@@ -17,7 +17,7 @@ pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
 pub use contact::{ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
 pub use joint::JointSpec;
 pub use load::LoadSpec;
-pub use overrides::apply_override;
+pub use overrides::{apply_override, lookup};
 
 use serde::{Deserialize, Serialize};
 
@@ -70,10 +70,44 @@ impl IntegratorKind {
         Self::Sdirk2,
     ];
 
-    /// Whether the step solves a linear system (the implicit integrators).
+    /// Whether the step solves a linear system (the implicit integrators);
+    /// an explicit integrator's step must resolve the stiffest contact.
     pub fn is_implicit(self) -> bool {
         matches!(self, Self::LinearlyImplicitEuler | Self::Sdirk2)
     }
+
+    /// Order of accuracy of the global error in the step.
+    pub fn order(self) -> u32 {
+        match self {
+            Self::SymplecticEuler | Self::LinearlyImplicitEuler => 1,
+            Self::Sdirk2 => 2,
+            Self::Rk4 => 4,
+        }
+    }
+
+    /// One line on what the integrator is.
+    pub fn description(self) -> &'static str {
+        match self {
+            Self::SymplecticEuler => "semi-implicit (symplectic) Euler: explicit, first order",
+            Self::Rk4 => "classical Runge-Kutta with Munthe-Kaas rotations: explicit, fourth order",
+            Self::LinearlyImplicitEuler => {
+                "Rosenbrock-Euler, implicit in the velocity-dependent forces: first order"
+            }
+            Self::Sdirk2 => {
+                "two-stage L-stable SDIRK with Newton iterations, implicit in every force: second order"
+            }
+        }
+    }
+}
+
+/// `interval / step` when it is a whole number ≥ 1 to within 1e-6 relative,
+/// else `None`: the one test of "a whole multiple of the step".
+pub fn whole_multiple(interval: f64, step: f64) -> Option<u64> {
+    let ratio = interval / step;
+    if !ratio.is_finite() || ratio.round() < 1.0 {
+        return None;
+    }
+    ((ratio - ratio.round()).abs() <= 1e-6 * ratio.max(1.0)).then(|| ratio.round() as u64)
 }
 
 /// Newton iterations of the `sdirk2` integrator.
@@ -167,6 +201,49 @@ pub struct SimulationSpec {
     pub divergence: DivergenceSpec,
 }
 
+impl SimulationSpec {
+    /// Checks the stepping, Newton and divergence settings.
+    fn validate(&self) -> Result<(), SceneError> {
+        positive("simulation.duration", self.duration)?;
+        positive("simulation.dt", self.dt)?;
+        positive("simulation.output_interval", self.output_interval)?;
+        if self.dt > self.duration {
+            return Err(SceneError::new(
+                "simulation.dt",
+                self.dt,
+                format!("step longer than the duration {} s", self.duration),
+            ));
+        }
+        if whole_multiple(self.output_interval, self.dt).is_none() {
+            return Err(SceneError::new(
+                "simulation.output_interval",
+                self.output_interval,
+                format!(
+                    "must be a whole multiple (≥ 1) of simulation.dt = {} s",
+                    self.dt
+                ),
+            ));
+        }
+        positive("simulation.newton.tolerance", self.newton.tolerance)?;
+        if self.newton.max_iterations == 0 {
+            return Err(SceneError::new(
+                "simulation.newton.max_iterations",
+                0,
+                "must be at least 1",
+            ));
+        }
+        let d = &self.divergence;
+        positive(
+            "simulation.divergence.penetration_fraction",
+            d.penetration_fraction,
+        )?;
+        if let Some(m) = d.max_penetration {
+            positive("simulation.divergence.max_penetration", m)?;
+        }
+        positive("simulation.divergence.energy_growth", d.energy_growth)
+    }
+}
+
 /// Global fields.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -182,7 +259,8 @@ impl Default for WorldSpec {
     }
 }
 
-/// Output tables a scene can ask for.
+/// The engine's output tables a scene can ask for (a scene kind built on
+/// top of the engine may add its own through the recorder's observers).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TableKind {
@@ -194,14 +272,6 @@ pub enum TableKind {
     Energy,
     /// Per-pair peak, mean and RMS of normal and tangential force over `record.summary_window`.
     Summary,
-    /// Drill pipe: per link per frame, the paper's eq. (4) angles and position.
-    Links,
-    /// Drill pipe: per hinge per frame, bend angle and cage forces.
-    Hinges,
-    /// Drill pipe: per ball key per frame, race and window forces.
-    Keys,
-    /// Drill pipe: per frame, input/output torque, speed, power and efficiency.
-    Drive,
 }
 
 impl TableKind {
@@ -212,43 +282,39 @@ impl TableKind {
             Self::Contacts => "contacts",
             Self::Energy => "energy",
             Self::Summary => "summary",
-            Self::Links => "links",
-            Self::Hinges => "hinges",
-            Self::Keys => "keys",
-            Self::Drive => "drive",
         }
     }
 
-    /// Every table kind.
-    pub const ALL: [TableKind; 8] = [
-        Self::Bodies,
-        Self::Contacts,
-        Self::Energy,
-        Self::Summary,
-        Self::Links,
-        Self::Hinges,
-        Self::Keys,
-        Self::Drive,
-    ];
+    /// Every engine table.
+    pub const ALL: [TableKind; 4] = [Self::Bodies, Self::Contacts, Self::Energy, Self::Summary];
+}
 
-    /// The kind named `name`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.into_iter().find(|k| k.name() == name)
+/// A table a scene can list in `record.tables`: the engine's
+/// ([`TableKind`]), or a set that a scene kind built on the engine extends.
+pub trait TableChoice: Copy + PartialEq + std::fmt::Debug {
+    /// The tables recorded when `record.tables` is left out.
+    fn defaults() -> Vec<Self>;
+    /// The table's name, also the Parquet file stem.
+    fn table_name(self) -> &'static str;
+}
+
+impl TableChoice for TableKind {
+    fn defaults() -> Vec<Self> {
+        vec![TableKind::Bodies, TableKind::Contacts]
     }
 
-    /// Whether only drill-pipe scenes can record it.
-    pub fn needs_drill_pipe(self) -> bool {
-        matches!(self, Self::Links | Self::Hinges | Self::Keys | Self::Drive)
+    fn table_name(self) -> &'static str {
+        self.name()
     }
 }
 
 /// What to record. Nothing else is computed for output.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct RecordSpec {
+pub struct RecordSpec<T: TableChoice = TableKind> {
     /// Tables to produce.
-    #[serde(default = "default_tables")]
-    pub tables: Vec<TableKind>,
+    #[serde(default = "T::defaults")]
+    pub tables: Vec<T>,
     /// Bodies recorded in `bodies`; empty means every non-fixed body.
     #[serde(default)]
     pub bodies: Vec<String>,
@@ -260,14 +326,72 @@ pub struct RecordSpec {
     pub summary_window: Vec<f64>,
 }
 
-fn default_tables() -> Vec<TableKind> {
-    vec![TableKind::Bodies, TableKind::Contacts]
+impl<T: TableChoice> RecordSpec<T> {
+    /// Checks the table list and the summary window (not the names, which
+    /// need the scene: [`Scene::validate`]).
+    pub fn validate_tables(&self) -> Result<(), SceneError> {
+        for (i, t) in self.tables.iter().enumerate() {
+            if self.tables[..i].contains(t) {
+                return Err(SceneError::new(
+                    format!("record.tables[{i}]"),
+                    t.table_name(),
+                    "listed twice",
+                ));
+            }
+        }
+        validate_window("record.summary_window", &self.summary_window)
+    }
 }
 
-impl Default for RecordSpec {
+impl RecordSpec {
+    /// Checks the tables, the summary window and the recorded names.
+    fn validate(&self, scene: &Scene) -> Result<(), SceneError> {
+        self.validate_tables()?;
+        for (i, n) in self.bodies.iter().enumerate() {
+            scene.body_id(&format!("record.bodies[{i}]"), n)?;
+        }
+        let names = scene.pair_names();
+        for (i, n) in self.contacts.iter().enumerate() {
+            if !names.contains(n) {
+                return Err(SceneError::new(
+                    format!("record.contacts[{i}]"),
+                    n,
+                    "no contact pair of that name",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Checks a time window `[start, end]` [s]; empty means the whole run.
+fn validate_window(path: &str, w: &[f64]) -> Result<(), SceneError> {
+    if w.is_empty() {
+        return Ok(());
+    }
+    if w.len() != 2 {
+        return Err(SceneError::new(
+            path,
+            format!("{w:?}"),
+            "give [start, end] in seconds",
+        ));
+    }
+    non_negative(&format!("{path}[0]"), w[0])?;
+    finite(&format!("{path}[1]"), w[1])?;
+    if w[1] <= w[0] {
+        return Err(SceneError::new(
+            format!("{path}[1]"),
+            w[1],
+            format!("must exceed the start {} s", w[0]),
+        ));
+    }
+    Ok(())
+}
+
+impl<T: TableChoice> Default for RecordSpec<T> {
     fn default() -> Self {
         Self {
-            tables: default_tables(),
+            tables: T::defaults(),
             bodies: vec![],
             contacts: vec![],
             summary_window: vec![],
@@ -301,80 +425,31 @@ pub struct Scene {
     /// Penalty joints.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joints: Vec<JointSpec>,
-    /// The higher-level spec this scene was expanded from, if any; it is what
-    /// [`Scene::to_toml`] writes back.
-    #[serde(skip)]
-    pub origin: Option<Box<crate::drillpipe::DrillPipeSpec>>,
 }
 
 impl Scene {
-    /// Parses TOML text, applies `dotted.key=value` overrides, and validates.
+    /// Parses a generic scene from TOML text, applies `dotted.key=value`
+    /// overrides, and validates. Documents that may be of another kind (a
+    /// `kind` key) are read by the loader, a layer above.
     pub fn from_toml_str(text: &str, overrides: &[String]) -> Result<Self, SceneError> {
-        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
-            SceneError::new(toml_error_path(&e, text), "", first_line(e.message()))
-        })?;
-        Self::from_table(table, overrides)
+        Self::from_table(parse_toml(text)?, overrides)
     }
 
-    /// Builds a scene from a TOML table (any serde source converts to one),
-    /// applies overrides, deserializes with field paths, and validates.
-    ///
-    /// A table with `kind = "drill-pipe"` (or, without `kind` and without
-    /// `bodies`, with a `pipe`, `borehole` or `drive` section) is a
-    /// [`DrillPipeSpec`](crate::drillpipe::DrillPipeSpec), expanded here.
+    /// Builds a generic scene from a TOML table (any serde source converts to
+    /// one), applies overrides, deserializes with field paths, and validates.
     pub fn from_table(table: toml::Table, overrides: &[String]) -> Result<Self, SceneError> {
-        let drill_pipe = match table.get("kind") {
-            Some(toml::Value::String(k)) if k == crate::drillpipe::KIND => true,
-            Some(toml::Value::String(k)) if k == "generic" => false,
-            Some(other) => {
-                return Err(SceneError::new(
-                    "kind",
-                    other,
-                    format!(
-                        "unknown scene kind (kinds: \"generic\", \"{}\")",
-                        crate::drillpipe::KIND
-                    ),
-                ));
-            }
-            None => {
-                !table.contains_key("bodies")
-                    && ["pipe", "borehole", "drive"]
-                        .iter()
-                        .any(|k| table.contains_key(*k))
-            }
-        };
-        let mut root = if drill_pipe {
-            // Sections and fields left out take the paper's values.
-            let mut base = toml::Value::try_from(crate::drillpipe::DrillPipeSpec::default())
-                .map_err(|e| SceneError::new("", "", format!("default drill-pipe scene: {e}")))?;
-            merge(&mut base, toml::Value::Table(table));
-            base
-        } else {
-            let mut t = table;
-            t.remove("kind");
-            toml::Value::Table(t)
-        };
+        let mut root = toml::Value::Table(table);
         for o in overrides {
             apply_override(&mut root, o)?;
-        }
-        if drill_pipe {
-            let spec: crate::drillpipe::DrillPipeSpec = deserialize_with_path(root)?;
-            return spec.expand();
         }
         let scene: Scene = deserialize_with_path(root)?;
         scene.validate()?;
         Ok(scene)
     }
 
-    /// The scene as TOML, with every default written out; a scene expanded
-    /// from a drill-pipe spec is written as that spec.
+    /// The scene as TOML, with every default written out.
     pub fn to_toml(&self) -> String {
-        if let Some(origin) = &self.origin {
-            return origin.to_toml();
-        }
-        // Serializing plain data with finite numbers cannot fail.
-        toml::to_string_pretty(self)
-            .unwrap_or_else(|e| format!("# scene could not be written: {e}\n"))
+        to_toml_text(self)
     }
 
     /// Index of the body named `name`.
@@ -384,48 +459,14 @@ impl Scene {
 
     /// Checks every value; the first problem found is returned with its path.
     pub fn validate(&self) -> Result<(), SceneError> {
-        let s = &self.simulation;
-        positive("simulation.duration", s.duration)?;
-        positive("simulation.dt", s.dt)?;
-        positive("simulation.output_interval", s.output_interval)?;
-        if s.dt > s.duration {
-            return Err(SceneError::new(
-                "simulation.dt",
-                s.dt,
-                format!("step longer than the duration {} s", s.duration),
-            ));
-        }
-        let ratio = s.output_interval / s.dt;
-        if (ratio - ratio.round()).abs() > 1e-6 * ratio.max(1.0) || ratio.round() < 1.0 {
-            return Err(SceneError::new(
-                "simulation.output_interval",
-                s.output_interval,
-                format!(
-                    "must be a whole multiple (≥ 1) of simulation.dt = {} s",
-                    s.dt
-                ),
-            ));
-        }
-        positive("simulation.newton.tolerance", s.newton.tolerance)?;
-        if s.newton.max_iterations == 0 {
-            return Err(SceneError::new(
-                "simulation.newton.max_iterations",
-                0,
-                "must be at least 1",
-            ));
-        }
-        positive(
-            "simulation.divergence.penetration_fraction",
-            s.divergence.penetration_fraction,
-        )?;
-        if let Some(d) = s.divergence.max_penetration {
-            positive("simulation.divergence.max_penetration", d)?;
-        }
-        positive(
-            "simulation.divergence.energy_growth",
-            s.divergence.energy_growth,
-        )?;
+        self.simulation.validate()?;
         finite_vec("world.gravity", &self.world.gravity)?;
+        self.validate_parts()?;
+        self.record.validate(self)
+    }
+
+    /// Bodies, contacts, loads and joints.
+    fn validate_parts(&self) -> Result<(), SceneError> {
         if self.bodies.is_empty() {
             return Err(SceneError::new(
                 "bodies",
@@ -446,7 +487,7 @@ impl Scene {
         for (i, c) in self.contacts.iter().enumerate() {
             c.validate(&format!("contacts[{i}]"), self)?;
         }
-        let names: Vec<String> = self.contacts.iter().map(|c| c.pair_name()).collect();
+        let names = self.pair_names();
         for (i, n) in names.iter().enumerate() {
             if names[..i].contains(n) {
                 return Err(SceneError::new(
@@ -462,60 +503,12 @@ impl Scene {
         for (i, j) in self.joints.iter().enumerate() {
             j.validate(&format!("joints[{i}]"), self)?;
         }
-        for (i, t) in self.record.tables.iter().enumerate() {
-            if t.needs_drill_pipe() && self.origin.is_none() {
-                return Err(SceneError::new(
-                    format!("record.tables[{i}]"),
-                    t.name(),
-                    "only drill-pipe scenes (kind = \"drill-pipe\") have this table",
-                ));
-            }
-            if self.record.tables[..i].contains(t) {
-                return Err(SceneError::new(
-                    format!("record.tables[{i}]"),
-                    t.name(),
-                    "listed twice",
-                ));
-            }
-        }
-        let w = &self.record.summary_window;
-        if !w.is_empty() {
-            if w.len() != 2 {
-                return Err(SceneError::new(
-                    "record.summary_window",
-                    format!("{w:?}"),
-                    "give [start, end] in seconds",
-                ));
-            }
-            non_negative("record.summary_window[0]", w[0])?;
-            finite("record.summary_window[1]", w[1])?;
-            if w[1] <= w[0] {
-                return Err(SceneError::new(
-                    "record.summary_window[1]",
-                    w[1],
-                    format!("must exceed the start {} s", w[0]),
-                ));
-            }
-        }
-        for (i, n) in self.record.bodies.iter().enumerate() {
-            if self.body_index(n).is_none() {
-                return Err(SceneError::new(
-                    format!("record.bodies[{i}]"),
-                    n,
-                    "no body of that name",
-                ));
-            }
-        }
-        for (i, n) in self.record.contacts.iter().enumerate() {
-            if !names.contains(n) {
-                return Err(SceneError::new(
-                    format!("record.contacts[{i}]"),
-                    n,
-                    "no contact pair of that name",
-                ));
-            }
-        }
         Ok(())
+    }
+
+    /// Names of the contact pairs, in order (pair ids).
+    pub fn pair_names(&self) -> Vec<String> {
+        self.contacts.iter().map(|c| c.pair_name()).collect()
     }
 
     /// Number of integrator steps per recorded frame.
@@ -533,7 +526,7 @@ impl Scene {
 /// Writes `over` onto `base`: tables merge key by key, anything else
 /// replaces. A table whose tag (`law` or `type`) differs replaces whole, so a
 /// different law does not inherit the old law's parameters.
-fn merge(base: &mut toml::Value, over: toml::Value) {
+pub(crate) fn merge(base: &mut toml::Value, over: toml::Value) {
     match (base, over) {
         (toml::Value::Table(b), toml::Value::Table(o)) => {
             let retagged = ["law", "type"]
@@ -557,7 +550,7 @@ fn merge(base: &mut toml::Value, over: toml::Value) {
 }
 
 /// Deserializes with the path of the offending field in the error.
-fn deserialize_with_path<T: serde::de::DeserializeOwned>(
+pub(crate) fn deserialize_with_path<T: serde::de::DeserializeOwned>(
     root: toml::Value,
 ) -> Result<T, SceneError> {
     serde_path_to_error::deserialize(root).map_err(|e| {
@@ -579,6 +572,19 @@ fn deserialize_with_path<T: serde::de::DeserializeOwned>(
         }
         SceneError::new(path, "", reason)
     })
+}
+
+/// Parses TOML text into a table; a syntax error names its line.
+pub(crate) fn parse_toml(text: &str) -> Result<toml::Table, SceneError> {
+    text.parse().map_err(|e: toml::de::Error| {
+        SceneError::new(toml_error_path(&e, text), "", first_line(e.message()))
+    })
+}
+
+/// Serializes a spec as TOML with every default written out.
+pub(crate) fn to_toml_text<T: Serialize>(spec: &T) -> String {
+    // Serializing plain data with finite numbers cannot fail.
+    toml::to_string_pretty(spec).unwrap_or_else(|e| format!("# scene could not be written: {e}\n"))
 }
 
 fn first_line(s: &str) -> String {

@@ -76,3 +76,42 @@ fn parse_value(raw: &str) -> toml::Value {
         Err(_) => toml::Value::String(raw.to_string()),
     }
 }
+
+/// The value at dotted `key` (the syntax of [`apply_override`]) in `root`.
+pub fn lookup<'a>(root: &'a toml::Value, key: &str) -> Result<&'a toml::Value, SceneError> {
+    let mut cur = root;
+    let parts: Vec<&str> = key.trim().split('.').collect();
+    for (i, part) in parts.iter().enumerate() {
+        let here = parts[..=i].join(".");
+        cur = match cur {
+            toml::Value::Table(t) => t.get(*part).ok_or_else(|| {
+                let keys: Vec<&str> = t.keys().map(String::as_str).collect();
+                SceneError::new(
+                    &here,
+                    "",
+                    format!("no such key (keys here: {})", keys.join(", ")),
+                )
+            })?,
+            toml::Value::Array(a) => {
+                let idx: usize = part.parse().map_err(|_| {
+                    SceneError::new(&here, part, "this level is a list: index it with a number")
+                })?;
+                a.get(idx).ok_or_else(|| {
+                    SceneError::new(
+                        &here,
+                        idx,
+                        format!("index out of range (the list has {} items)", a.len()),
+                    )
+                })?
+            }
+            _ => {
+                return Err(SceneError::new(
+                    &here,
+                    "",
+                    "is not a table or list, so it has no sub-keys",
+                ));
+            }
+        };
+    }
+    Ok(cur)
+}

@@ -54,7 +54,7 @@ impl Probe {
     }
 }
 
-/// The incline of physics.md §7.7: a 1 kg block on a horizontal plane with
+/// The incline of docs/model.md §7.7: a 1 kg block on a horizontal plane with
 /// gravity tilted to α from vertical, g = 9.8·(cos α, 0, −sin α), a linear
 /// normal law and the Adams friction law (μs 0.3, μd 0.1, v_s 0.1, v_d 1 m/s).
 pub fn incline_scene(

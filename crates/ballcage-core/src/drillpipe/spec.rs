@@ -1,0 +1,554 @@
+//! The drill-pipe scene document: engineering parameters with the paper's
+//! defaults, and their validation. Units are SI (lengths in m, masses in kg)
+//! except where a field name says `_deg` or `_rpm`; contact laws keep the
+//! paper's N-mm-s field units, converted once on assembly.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SceneError;
+use crate::scene::{
+    DivergenceSpec, FieldUnits, FrictionLawSpec, IntegratorKind, NewtonSpec, NormalLawSpec,
+    RecordSpec, SimulationSpec, TableChoice, TableKind, finite, non_negative, positive,
+};
+
+/// The guide tube (borehole) [m, deg].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BoreholeSpec {
+    /// Centreline curvature radius R [m]. Paper: 1.5.
+    pub curvature_radius: f64,
+    /// Build angle of the arc, from vertical [deg]. Paper: 90.
+    pub build_angle_deg: f64,
+    /// Guide tube inner diameter [m]. Paper (Table 1): 0.116.
+    pub inner_diameter: f64,
+}
+
+impl Default for BoreholeSpec {
+    fn default() -> Self {
+        Self {
+            curvature_radius: 1.5,
+            build_angle_deg: 90.0,
+            inner_diameter: 0.116,
+        }
+    }
+}
+
+/// Hinge model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum HingeModel {
+    /// The paper's model: cage and six ball keys per hinge, all contacts analytic.
+    #[default]
+    BallKeys,
+    /// Reduced model: ideal constant-velocity joints, link–tube contacts only.
+    IdealCv,
+}
+
+/// Ball-cage joint dimensions and masses (docs/model.md §3) [m, kg, kg·m², deg].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BallKeySpec {
+    /// Ball key radius r_b [m]: Ø15 mm.
+    pub ball_radius: f64,
+    /// Ball key mass [kg]: steel Ø15 sphere.
+    pub ball_mass: f64,
+    /// Pitch radius of the ball set, PCR [m]. PROPOSAL: 31.5 mm (cage mid-surface).
+    pub pitch_radius: f64,
+    /// Groove-centre offset per race, c [m]. PROPOSAL: 4 mm.
+    pub groove_offset: f64,
+    /// Gothic-arch flank radius ρ_g [m]. PROPOSAL: 7.8 mm (conformity 1.04).
+    pub groove_radius: f64,
+    /// Flank contact angle α [deg]. PROPOSAL: 45.
+    pub contact_angle_deg: f64,
+    /// Ball–flank clearance per flank [m]. PROPOSAL: 0.01 mm.
+    pub flank_clearance: f64,
+    /// Ball head sphere radius [m]. PROPOSAL: 30.99 mm.
+    pub head_radius: f64,
+    /// Cage inner sphere radius [m] (Table 1: 31 mm).
+    pub cage_inner_radius: f64,
+    /// Cage outer sphere radius [m] (Table 1: 32 mm).
+    pub cage_outer_radius: f64,
+    /// Ball seat sphere radius [m]. PROPOSAL: 32.01 mm.
+    pub seat_radius: f64,
+    /// Cage mass [kg] (64/62 × 40 mm shell less six windows).
+    pub cage_mass: f64,
+    /// Cage principal inertia, axial then transverse [kg·m²].
+    pub cage_inertia: [f64; 3],
+    /// Window width along the cage axis [m]. PROPOSAL: 15.03 mm.
+    pub window_axial_width: f64,
+    /// Window length around the cage [m]. PROPOSAL: 16.1 mm.
+    pub window_length: f64,
+    /// Articulation stop (head–seat cone contact) [deg]. PROPOSAL: 15.
+    pub bend_limit_deg: f64,
+    /// Stop stiffness [N·m/rad]. PROPOSAL: 1e6.
+    pub stop_stiffness: f64,
+}
+
+impl Default for BallKeySpec {
+    fn default() -> Self {
+        Self {
+            ball_radius: 0.0075,
+            ball_mass: 0.013872,
+            pitch_radius: 0.0315,
+            groove_offset: 0.004,
+            groove_radius: 0.0078,
+            contact_angle_deg: 45.0,
+            flank_clearance: 1e-5,
+            head_radius: 0.03099,
+            cage_inner_radius: 0.031,
+            cage_outer_radius: 0.032,
+            seat_radius: 0.03201,
+            cage_mass: 0.0515,
+            cage_inertia: [5.1e-5, 3.2e-5, 3.2e-5],
+            window_axial_width: 0.01503,
+            window_length: 0.0161,
+            bend_limit_deg: 15.0,
+            stop_stiffness: 1e6,
+        }
+    }
+}
+
+/// Ideal constant-velocity hinge: penalty joint parameters [SI, deg].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IdealCvSpec {
+    /// Hinge-point spring [N/m]. PROPOSAL: 1e9 (1.2 µm under the 1.2 kN hinge shear).
+    pub stiffness: f64,
+    /// Hinge-point damper [N·s/m]. PROPOSAL: 1.3e5 (about critical for two 8 kg links).
+    pub damping: f64,
+    /// Twist spring [N·m/rad]. PROPOSAL: 1.1e5, the ball-key hinge's tangent stiffness at 1.8 kN·m if the 45° contact angle held (docs/model.md §7.9; with the default groove the angle opens and the section model gives about 1.7e5 tangent, 6.9e4 secant).
+    pub twist_stiffness: f64,
+    /// Twist damper [N·m·s/rad]. PROPOSAL: 60 (about critical for a link's spin inertia).
+    pub twist_damping: f64,
+    /// Articulation stop [deg]. PROPOSAL: 15.
+    pub bend_limit_deg: f64,
+    /// Stop spring [N·m/rad]. PROPOSAL: 1e6.
+    pub stop_stiffness: f64,
+}
+
+impl Default for IdealCvSpec {
+    fn default() -> Self {
+        Self {
+            stiffness: 1e9,
+            damping: 1.3e5,
+            twist_stiffness: 1.1e5,
+            twist_damping: 60.0,
+            bend_limit_deg: 15.0,
+            stop_stiffness: 1e6,
+        }
+    }
+}
+
+/// The chain [m, kg, kg·m²].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PipeSpec {
+    /// Number of flexible joints (links). Paper: 12.
+    pub joints: usize,
+    /// Hinge model.
+    pub hinge: HingeModel,
+    /// Hinge-to-hinge pitch, one link's length [m]. Paper: 0.2.
+    pub pitch: f64,
+    /// Link outer diameter for tube contact [m]. Paper (Table 1): 0.086.
+    pub link_diameter: f64,
+    /// Link mass [kg]: 86/30 × 200 mm steel envelope.
+    pub link_mass: f64,
+    /// Link principal inertia, axial then transverse [kg·m²].
+    pub link_inertia: [f64; 3],
+    /// Connector length [m] (Table 1: 200 mm).
+    pub connector_length: f64,
+    /// Connector outer diameter [m] (Table 1: 122 mm).
+    pub connector_diameter: f64,
+    /// Connector mass [kg].
+    pub connector_mass: f64,
+    /// Connector principal inertia, axial then transverse [kg·m²].
+    pub connector_inertia: [f64; 3],
+    /// Sample points along each link for link–tube contact. PROPOSAL: 5.
+    pub tube_contact_points: u32,
+    /// Ball-cage joint details (used by `hinge = "ball-keys"`).
+    pub ball_keys: BallKeySpec,
+    /// Ideal CV joint details (used by `hinge = "ideal-cv"`).
+    pub ideal_cv: IdealCvSpec,
+}
+
+impl Default for PipeSpec {
+    fn default() -> Self {
+        Self {
+            joints: 12,
+            hinge: HingeModel::BallKeys,
+            pitch: 0.2,
+            link_diameter: 0.086,
+            link_mass: 8.010,
+            link_inertia: [8.306e-3, 3.085e-2, 3.085e-2],
+            connector_length: 0.2,
+            connector_diameter: 0.122,
+            connector_mass: 17.243,
+            connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
+            tube_contact_points: 5,
+            ball_keys: BallKeySpec::default(),
+            ideal_cv: IdealCvSpec::default(),
+        }
+    }
+}
+
+/// The drive on the upper connector.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DriveSpec {
+    /// Drive speed [rpm]. Paper: 100.
+    pub speed_rpm: f64,
+    /// STEP ramp from rest to full speed [s]. PROPOSAL: 0.3 (the paper gives none).
+    pub ramp: f64,
+}
+
+impl Default for DriveSpec {
+    fn default() -> Self {
+        Self {
+            speed_rpm: 100.0,
+            ramp: 0.3,
+        }
+    }
+}
+
+/// The resisting moment on the lower connector.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ResistingMomentSpec {
+    /// Resisting moment, opposing the spin [N·m]. Paper: 1800.
+    pub resisting_moment: f64,
+    /// STEP ramp [s]; 0 applies it at once. PROPOSAL: 0.3.
+    pub ramp: f64,
+}
+
+impl Default for ResistingMomentSpec {
+    fn default() -> Self {
+        Self {
+            resisting_moment: 1800.0,
+            ramp: 0.3,
+        }
+    }
+}
+
+/// A contact material: normal law and friction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Normal law.
+    pub normal: NormalLawSpec,
+    /// Friction law.
+    pub friction: FrictionLawSpec,
+}
+
+fn paper_impact() -> NormalLawSpec {
+    NormalLawSpec::Impact {
+        stiffness: 1e5,
+        exponent: 2.2,
+        damping: 10.0,
+        depth_max: 0.1,
+        units: FieldUnits::NMmS,
+    }
+}
+
+fn adams(mu_static: f64, mu_dynamic: f64) -> FrictionLawSpec {
+    FrictionLawSpec::Adams {
+        mu_static,
+        mu_dynamic,
+        v_static: 100.0,
+        v_dynamic: 1000.0,
+        units: FieldUnits::NMmS,
+    }
+}
+
+/// The two contact materials of the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MaterialsSpec {
+    /// Link–guide tube (dry): μs 0.3, μd 0.1.
+    pub tube: MaterialSpec,
+    /// Inside the joints (lubricated): μs 0.1, μd 0.01.
+    pub internal: MaterialSpec,
+}
+
+impl Default for MaterialsSpec {
+    fn default() -> Self {
+        Self {
+            tube: MaterialSpec {
+                normal: paper_impact(),
+                friction: adams(0.3, 0.1),
+            },
+            internal: MaterialSpec {
+                normal: paper_impact(),
+                friction: adams(0.1, 0.01),
+            },
+        }
+    }
+}
+
+/// Gravity magnitude, pointing along −z (z up).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GravitySpec {
+    /// [m/s²]. Paper: 9.8.
+    pub gravity: f64,
+}
+
+impl Default for GravitySpec {
+    fn default() -> Self {
+        Self { gravity: 9.8 }
+    }
+}
+
+/// A drill-pipe scene. Every section has the paper's defaults.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DrillPipeSpec {
+    /// Always `"drill-pipe"`.
+    pub kind: String,
+    /// Scene name.
+    pub name: String,
+    /// Time stepping. The paper's 1 ms is the output interval, not the step.
+    /// Default: SDIRK2 at 100 µs, within 0.1 % of a converged reference on
+    /// every quantity of `ballcage accuracy` (docs/accuracy.md). Explicit
+    /// integrators need 0.1 µs here: at 1 µs the lubricated key friction (a
+    /// damper of rate ~4e6 1/s at 10 kN) chatters, and even 0.2 µs drifts
+    /// once the keys carry their full load (docs/paper.md).
+    pub simulation: SimulationSpec,
+    /// Gravity.
+    pub world: GravitySpec,
+    /// Guide tube.
+    pub borehole: BoreholeSpec,
+    /// Chain.
+    pub pipe: PipeSpec,
+    /// Drive.
+    pub drive: DriveSpec,
+    /// Resisting moment.
+    pub load: ResistingMomentSpec,
+    /// Contact materials.
+    pub materials: MaterialsSpec,
+    /// What to record.
+    pub record: PipeRecordSpec,
+}
+
+/// The `kind` of a drill-pipe scene document.
+pub const KIND: &str = "drill-pipe";
+
+impl Default for DrillPipeSpec {
+    fn default() -> Self {
+        Self {
+            kind: KIND.to_string(),
+            name: "Zhu et al. 2023: 12 ball-cage joints, R 1.5 m, 100 rpm, 1.8 kN·m".to_string(),
+            simulation: SimulationSpec {
+                duration: 1.8,
+                dt: 1e-4,
+                output_interval: 1e-3,
+                integrator: IntegratorKind::Sdirk2,
+                newton: NewtonSpec::default(),
+                divergence: DivergenceSpec::default(),
+            },
+            world: GravitySpec::default(),
+            borehole: BoreholeSpec::default(),
+            pipe: PipeSpec::default(),
+            drive: DriveSpec::default(),
+            load: ResistingMomentSpec::default(),
+            materials: MaterialsSpec::default(),
+            record: PipeRecordSpec::default(),
+        }
+    }
+}
+
+/// An output table of a drill-pipe scene: the engine's, or the drill pipe's own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PipeTable {
+    /// The engine's `bodies` table.
+    Bodies,
+    /// The engine's `contacts` table.
+    Contacts,
+    /// The engine's `energy` table.
+    Energy,
+    /// The engine's `summary` table.
+    Summary,
+    /// Per link per frame: the paper's eq. (4) angles, position, offsets and tube force.
+    Links,
+    /// Per hinge per frame: bend angle and cage forces.
+    Hinges,
+    /// Per ball key per frame: race and window forces.
+    Keys,
+    /// Per frame: input/output torque, speed, power and efficiency.
+    Drive,
+}
+
+impl PipeTable {
+    /// The engine table this is, if it is one.
+    pub fn engine(self) -> Option<TableKind> {
+        match self {
+            Self::Bodies => Some(TableKind::Bodies),
+            Self::Contacts => Some(TableKind::Contacts),
+            Self::Energy => Some(TableKind::Energy),
+            Self::Summary => Some(TableKind::Summary),
+            Self::Links | Self::Hinges | Self::Keys | Self::Drive => None,
+        }
+    }
+}
+
+impl TableChoice for PipeTable {
+    fn defaults() -> Vec<Self> {
+        vec![PipeTable::Bodies, PipeTable::Contacts]
+    }
+
+    fn table_name(self) -> &'static str {
+        match self {
+            Self::Links => "links",
+            Self::Hinges => "hinges",
+            Self::Keys => "keys",
+            Self::Drive => "drive",
+            engine => engine.engine().map_or("", TableKind::name),
+        }
+    }
+}
+
+/// What a drill-pipe scene records: the engine's tables and the drill
+/// pipe's (`links`, `hinges`, `keys`, `drive`). `bodies` names parts (e.g.
+/// `link03`); empty means the connectors and the links.
+pub type PipeRecordSpec = RecordSpec<PipeTable>;
+
+impl DrillPipeSpec {
+    /// The document as TOML, every default written out.
+    pub fn to_toml(&self) -> String {
+        crate::scene::to_toml_text(self)
+    }
+
+    /// Checks every section; the first problem found is returned with its path.
+    pub fn validate(&self) -> Result<(), SceneError> {
+        if self.kind != KIND {
+            return Err(SceneError::new(
+                "kind",
+                &self.kind,
+                format!("a drill-pipe scene has kind = \"{KIND}\""),
+            ));
+        }
+        self.borehole.validate()?;
+        self.pipe.validate(&self.borehole)?;
+        non_negative("drive.ramp", self.drive.ramp)?;
+        finite("drive.speed_rpm", self.drive.speed_rpm)?;
+        finite("load.resisting_moment", self.load.resisting_moment)?;
+        non_negative("load.ramp", self.load.ramp)?;
+        finite("world.gravity", self.world.gravity)?;
+        self.record.validate_tables()
+    }
+}
+
+impl BoreholeSpec {
+    fn validate(&self) -> Result<(), SceneError> {
+        positive("borehole.curvature_radius", self.curvature_radius)?;
+        positive("borehole.build_angle_deg", self.build_angle_deg)?;
+        if self.build_angle_deg > 180.0 {
+            return Err(SceneError::new(
+                "borehole.build_angle_deg",
+                self.build_angle_deg,
+                "must be at most 180",
+            ));
+        }
+        positive("borehole.inner_diameter", self.inner_diameter)
+    }
+}
+
+impl PipeSpec {
+    fn validate(&self, borehole: &BoreholeSpec) -> Result<(), SceneError> {
+        if self.joints == 0 {
+            return Err(SceneError::new(
+                "pipe.joints",
+                self.joints,
+                "needs at least one flexible joint",
+            ));
+        }
+        if self.joints > 200 {
+            return Err(SceneError::new(
+                "pipe.joints",
+                self.joints,
+                "more than 200 joints is not a drill pipe this tool models",
+            ));
+        }
+        positive("pipe.pitch", self.pitch)?;
+        positive("pipe.link_diameter", self.link_diameter)?;
+        if self.link_diameter >= borehole.inner_diameter {
+            return Err(SceneError::new(
+                "pipe.link_diameter",
+                self.link_diameter,
+                format!(
+                    "does not fit the guide tube (borehole.inner_diameter = {})",
+                    borehole.inner_diameter
+                ),
+            ));
+        }
+        if 2.0 * borehole.curvature_radius <= self.pitch {
+            return Err(SceneError::new(
+                "borehole.curvature_radius",
+                borehole.curvature_radius,
+                format!("a {} m link cannot follow a bend this tight", self.pitch),
+            ));
+        }
+        positive("pipe.connector_length", self.connector_length)?;
+        positive("pipe.connector_diameter", self.connector_diameter)?;
+        self.ideal_cv.validate()?;
+        self.ball_keys.validate()
+    }
+}
+
+impl IdealCvSpec {
+    fn validate(&self) -> Result<(), SceneError> {
+        for (name, v) in [
+            ("stiffness", self.stiffness),
+            ("twist_stiffness", self.twist_stiffness),
+            ("bend_limit_deg", self.bend_limit_deg),
+            ("stop_stiffness", self.stop_stiffness),
+        ] {
+            positive(&format!("pipe.ideal_cv.{name}"), v)?;
+        }
+        non_negative("pipe.ideal_cv.damping", self.damping)?;
+        non_negative("pipe.ideal_cv.twist_damping", self.twist_damping)
+    }
+}
+
+impl BallKeySpec {
+    fn validate(&self) -> Result<(), SceneError> {
+        for (name, v) in [
+            ("ball_radius", self.ball_radius),
+            ("ball_mass", self.ball_mass),
+            ("pitch_radius", self.pitch_radius),
+            ("groove_offset", self.groove_offset),
+            ("groove_radius", self.groove_radius),
+            ("contact_angle_deg", self.contact_angle_deg),
+            ("head_radius", self.head_radius),
+            ("cage_inner_radius", self.cage_inner_radius),
+            ("cage_outer_radius", self.cage_outer_radius),
+            ("seat_radius", self.seat_radius),
+            ("cage_mass", self.cage_mass),
+            ("window_axial_width", self.window_axial_width),
+            ("window_length", self.window_length),
+            ("bend_limit_deg", self.bend_limit_deg),
+            ("stop_stiffness", self.stop_stiffness),
+        ] {
+            positive(&format!("pipe.ball_keys.{name}"), v)?;
+        }
+        non_negative("pipe.ball_keys.flank_clearance", self.flank_clearance)?;
+        if self.groove_radius <= self.ball_radius + self.flank_clearance {
+            return Err(SceneError::new(
+                "pipe.ball_keys.groove_radius",
+                self.groove_radius,
+                "must exceed ball_radius + flank_clearance (a Gothic arch wider than the ball)",
+            ));
+        }
+        if !(self.head_radius < self.cage_inner_radius
+            && self.cage_inner_radius < self.cage_outer_radius
+            && self.cage_outer_radius < self.seat_radius)
+        {
+            return Err(SceneError::new(
+                "pipe.ball_keys.head_radius",
+                self.head_radius,
+                "needs head_radius < cage_inner_radius < cage_outer_radius < seat_radius",
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,423 @@
+//! The drill pipe's own output tables, filled by an [`Observer`] the
+//! drill-pipe layer registers with the simulation: `links`, `hinges`,
+//! `keys` and `drive`. Parts are identified by integer columns (`link`,
+//! `hinge`, `key`), never by names.
+
+use super::layout::Layout;
+use super::spec::PipeTable;
+use crate::math::{Vec3, angle_between};
+use crate::model::Motion;
+use crate::record::{
+    Cell, ColumnDef, ColumnKind, Dictionary, Frame, Observer, STEP, TIME, TableBuffer, TableDef,
+    col, contact_totals,
+};
+
+use ColumnKind::{F64, Name, U32};
+
+/// Columns of the `links` table (drill pipe): one row per link per frame.
+const LINKS_COLUMNS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "link",
+        U32,
+        "",
+        "link number, 1 at the top (the paper's joint number)",
+    ),
+    col("body", Name(Dictionary::Bodies), "", "body name"),
+    col(
+        "inclination_deg",
+        F64,
+        "deg",
+        "eq. (4) φ: angle of the link axis from the downward vertical",
+    ),
+    col(
+        "azimuth_deg",
+        F64,
+        "deg",
+        "eq. (4) θ: azimuth of the link axis about the vertical, from the bend direction (+x)",
+    ),
+    col("com_x", F64, "m", "centre of mass x, world frame"),
+    col("com_y", F64, "m", "centre of mass y, world frame"),
+    col("com_z", F64, "m", "centre of mass z, world frame"),
+    col(
+        "radial_offset",
+        F64,
+        "m",
+        "distance of the centre of mass from the tube centreline (extended straight past the arc)",
+    ),
+    col(
+        "included_angle_deg",
+        F64,
+        "deg",
+        "angle between this link's axis and the next body's, 180 when straight",
+    ),
+    col(
+        "offset_outward",
+        F64,
+        "m",
+        "centre-of-mass offset from the tube centreline in the bend plane, + toward the outer wall of the bend",
+    ),
+    col(
+        "offset_lateral",
+        F64,
+        "m",
+        "centre-of-mass offset from the tube centreline out of the bend plane",
+    ),
+    col(
+        "tube_normal",
+        F64,
+        "N",
+        "total normal force of the link's contact with the tube",
+    ),
+    col(
+        "tube_tangential",
+        F64,
+        "N",
+        "magnitude of the summed friction force of the link's contact with the tube",
+    ),
+];
+
+/// Columns of the `hinges` table (drill pipe): one row per hinge per frame.
+const HINGES_COLUMNS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "hinge",
+        U32,
+        "",
+        "hinge number, 0 between the upper connector and link 1",
+    ),
+    col("bend_deg", F64, "deg", "angle between the two bodies' axes"),
+    col(
+        "cage_head_normal",
+        F64,
+        "N",
+        "normal force between cage and ball head",
+    ),
+    col(
+        "cage_head_tangential",
+        F64,
+        "N",
+        "friction force magnitude between cage and ball head",
+    ),
+    col(
+        "cage_seat_normal",
+        F64,
+        "N",
+        "normal force between cage and ball seat",
+    ),
+    col(
+        "cage_seat_tangential",
+        F64,
+        "N",
+        "friction force magnitude between cage and ball seat",
+    ),
+];
+
+/// Columns of the `keys` table (drill pipe): one row per ball key per frame.
+/// Race forces add both Gothic-arch flanks; window forces both window pairs.
+const KEYS_COLUMNS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col("hinge", U32, "", "hinge number"),
+    col("key", U32, "", "ball key number, 0–5 around the joint"),
+    col(
+        "inner_normal",
+        F64,
+        "N",
+        "normal force on the inner race (ball head grooves), both flanks",
+    ),
+    col(
+        "inner_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the inner race",
+    ),
+    col(
+        "outer_normal",
+        F64,
+        "N",
+        "normal force on the outer race (ball seat grooves), both flanks",
+    ),
+    col(
+        "outer_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the outer race",
+    ),
+    col(
+        "window_normal",
+        F64,
+        "N",
+        "normal force on the cage window faces",
+    ),
+    col(
+        "window_tangential",
+        F64,
+        "N",
+        "friction force magnitude on the cage window faces",
+    ),
+];
+
+/// Columns of the `drive` table (drill pipe): one row per frame.
+const DRIVE_COLUMNS: &[ColumnDef] = &[
+    STEP,
+    TIME,
+    col(
+        "input_speed",
+        F64,
+        "rad/s",
+        "prescribed spin speed of the upper connector",
+    ),
+    col(
+        "input_torque",
+        F64,
+        "N*m",
+        "torque the drive applies to the upper connector about its axis",
+    ),
+    col(
+        "output_speed",
+        F64,
+        "rad/s",
+        "spin speed of the lower connector",
+    ),
+    col(
+        "output_torque",
+        F64,
+        "N*m",
+        "resisting moment applied to the lower connector (opposing its spin)",
+    ),
+    col("input_power", F64, "W", "input_torque × input_speed"),
+    col("output_power", F64, "W", "output_torque × output_speed"),
+    col(
+        "efficiency",
+        F64,
+        "1",
+        "output_power / input_power; 0 while the input power is not positive",
+    ),
+];
+
+/// The `links` table.
+pub const LINKS: TableDef = TableDef {
+    name: "links",
+    row: "one row per link per frame",
+    columns: LINKS_COLUMNS,
+};
+/// The `hinges` table.
+pub const HINGES: TableDef = TableDef {
+    name: "hinges",
+    row: "one row per hinge per frame",
+    columns: HINGES_COLUMNS,
+};
+/// The `keys` table.
+pub const KEYS: TableDef = TableDef {
+    name: "keys",
+    row: "one row per ball key per frame",
+    columns: KEYS_COLUMNS,
+};
+/// The `drive` table.
+pub const DRIVE: TableDef = TableDef {
+    name: "drive",
+    row: "one row per frame",
+    columns: DRIVE_COLUMNS,
+};
+
+/// The drill pipe's tables, in the order `ballcage schema` lists them.
+pub const TABLES: [&TableDef; 4] = [&LINKS, &HINGES, &KEYS, &DRIVE];
+
+/// The drill pipe's own table of a `record.tables` entry, if it is one.
+pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
+    match table {
+        PipeTable::Links => Some(&LINKS),
+        PipeTable::Hinges => Some(&HINGES),
+        PipeTable::Keys => Some(&KEYS),
+        PipeTable::Drive => Some(&DRIVE),
+        PipeTable::Bodies | PipeTable::Contacts | PipeTable::Energy | PipeTable::Summary => None,
+    }
+}
+
+/// Fills the drill pipe's tables the scene asked for.
+#[derive(Debug, Clone)]
+pub struct PipeTables {
+    layout: Layout,
+    tables: Vec<PipeTable>,
+}
+
+impl PipeTables {
+    /// An observer of the pipe laid out as `layout`, for the drill-pipe
+    /// entries of `tables` (engine tables are skipped).
+    pub fn new(layout: Layout, tables: &[PipeTable]) -> Self {
+        let tables = tables
+            .iter()
+            .copied()
+            .filter(|t| table_def(*t).is_some())
+            .collect();
+        Self { layout, tables }
+    }
+}
+
+impl Observer for PipeTables {
+    fn tables(&self) -> Vec<&'static TableDef> {
+        self.tables.iter().filter_map(|t| table_def(*t)).collect()
+    }
+
+    fn needs_contacts(&self) -> bool {
+        !self.tables.is_empty()
+    }
+
+    fn record(&mut self, frame: &Frame<'_>, out: &mut [TableBuffer]) {
+        for (table, kind) in out.iter_mut().zip(&self.tables) {
+            match kind {
+                PipeTable::Links => links(table, &self.layout, frame),
+                PipeTable::Hinges => hinges(table, &self.layout, frame),
+                PipeTable::Keys => keys(table, &self.layout, frame),
+                PipeTable::Drive => drive(table, &self.layout, frame),
+                _ => {}
+            }
+        }
+    }
+
+    fn clone_box(&self) -> Box<dyn Observer> {
+        Box::new(self.clone())
+    }
+}
+
+/// The step and time cells of a frame.
+fn stamp(f: &Frame<'_>) -> (Cell, Cell) {
+    (Cell::U64(f.step), Cell::F64(f.state.t))
+}
+
+/// World axis (body x) of body `i`.
+fn axis(f: &Frame<'_>, i: usize) -> Vec3 {
+    f.state.rot[i] * Vec3::x()
+}
+
+fn links(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+    let (step, t) = stamp(f);
+    let chain = &layout.chain;
+    for k in 1..chain.len().saturating_sub(1) {
+        let i = chain[k];
+        let d = axis(f, i);
+        let (phi, theta) = super::chain::eq4_angles(&d);
+        let c = f.state.pos[i];
+        let (offset, outward, lateral) = layout.offsets(&c);
+        let included = 180.0 - angle_between(&d, &axis(f, chain[k + 1])).to_degrees();
+        let (tube_n, tube_t) = contact_totals(f.contacts, &layout.tube_pairs[k - 1..k]);
+        table.push(&[
+            step,
+            t,
+            Cell::U32(k as u32),
+            Cell::U32(i as u32),
+            Cell::F64(phi.to_degrees()),
+            Cell::F64(theta.to_degrees()),
+            Cell::F64(c.x),
+            Cell::F64(c.y),
+            Cell::F64(c.z),
+            Cell::F64(offset),
+            Cell::F64(included),
+            Cell::F64(outward),
+            Cell::F64(lateral),
+            Cell::F64(tube_n),
+            Cell::F64(tube_t),
+        ]);
+    }
+}
+
+fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+    let (step, t) = stamp(f);
+    for (h, hinge) in layout.hinges.iter().enumerate() {
+        let bend = angle_between(&axis(f, layout.chain[h]), &axis(f, layout.chain[h + 1]));
+        let (hn, ht) = contact_totals(f.contacts, hinge.cage_head.as_slice());
+        let (sn, st) = contact_totals(f.contacts, hinge.cage_seat.as_slice());
+        table.push(&[
+            step,
+            t,
+            Cell::U32(h as u32),
+            Cell::F64(bend.to_degrees()),
+            Cell::F64(hn),
+            Cell::F64(ht),
+            Cell::F64(sn),
+            Cell::F64(st),
+        ]);
+    }
+}
+
+fn keys(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+    let (step, t) = stamp(f);
+    for (h, hinge) in layout.hinges.iter().enumerate() {
+        for (j, key) in hinge.keys.iter().enumerate() {
+            let (i_n, i_t) = contact_totals(f.contacts, &key.inner);
+            let (o_n, o_t) = contact_totals(f.contacts, &key.outer);
+            let (w_n, w_t) = contact_totals(f.contacts, &key.window);
+            table.push(&[
+                step,
+                t,
+                Cell::U32(h as u32),
+                Cell::U32(j as u32),
+                Cell::F64(i_n),
+                Cell::F64(i_t),
+                Cell::F64(o_n),
+                Cell::F64(o_t),
+                Cell::F64(w_n),
+                Cell::F64(w_t),
+            ]);
+        }
+    }
+}
+
+/// Speed [rad/s] and torque [N·m] of the drive on the upper connector: what
+/// the contacts and joints take, plus what spins up the connector.
+fn input(layout: &Layout, f: &Frame<'_>) -> (f64, f64) {
+    let (model, s) = (f.model, f.state);
+    let upper = layout.chain[0];
+    let Motion::KinematicSpin(p) = model.bodies[upper].motion else {
+        return (0.0, 0.0);
+    };
+    let joints: Vec3 = model.joints.iter().map(|j| j.torque_on(s, upper)).sum();
+    let contact =
+        (crate::dynamics::contact_torque(model, s, f.contacts, upper) + joints).dot(&p.axis);
+    let inertia = p.axis.dot(
+        &(s.rot[upper]
+            * model.bodies[upper]
+                .inertia
+                .component_mul(&(s.rot[upper].inverse() * p.axis))),
+    );
+    (p.speed_at(s.t), inertia * p.acceleration_at(s.t) - contact)
+}
+
+/// Speed [rad/s] of the lower connector and the resisting moment on it [N·m].
+fn output(layout: &Layout, f: &Frame<'_>) -> (f64, f64) {
+    let (model, s) = (f.model, f.state);
+    let lower = layout.chain[layout.chain.len() - 1];
+    let Motion::Spin { axis, .. } = model.bodies[lower].motion else {
+        return (0.0, 0.0);
+    };
+    let applied: f64 = model
+        .torques
+        .iter()
+        .filter(|l| l.body == lower)
+        .map(|l| l.torque(s.t).dot(&axis))
+        .sum();
+    (s.omega_world(lower).dot(&axis), -applied)
+}
+
+fn drive(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+    let (step, t) = stamp(f);
+    let (input_speed, input_torque) = input(layout, f);
+    let (output_speed, output_torque) = output(layout, f);
+    let p_in = input_torque * input_speed;
+    let p_out = output_torque * output_speed;
+    let efficiency = if p_in > 1e-9 { p_out / p_in } else { 0.0 };
+    table.push(&[
+        step,
+        t,
+        Cell::F64(input_speed),
+        Cell::F64(input_torque),
+        Cell::F64(output_speed),
+        Cell::F64(output_torque),
+        Cell::F64(p_in),
+        Cell::F64(p_out),
+        Cell::F64(efficiency),
+    ]);
+}

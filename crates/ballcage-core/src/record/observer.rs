@@ -1,0 +1,66 @@
+//! The interface through which a layer above the engine adds output tables.
+//!
+//! The engine records its own tables ([`super::BODIES`], [`super::CONTACTS`],
+//! [`super::ENERGY`], [`super::SUMMARY`]). A scene kind built on top of it,
+//! such as the drill pipe, registers an [`Observer`] with the simulation; at
+//! every recorded frame the recorder hands each observer the frame and the
+//! buffers of the tables it declared. The engine never needs to know what
+//! those tables mean.
+
+use std::fmt::Debug;
+
+use super::{TableBuffer, TableDef};
+use crate::dynamics::ContactEval;
+use crate::math::Vec3;
+use crate::model::{Model, State};
+
+/// What an observer sees of one recorded frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Frame<'a> {
+    /// The assembled model.
+    pub model: &'a Model,
+    /// The state at the frame.
+    pub state: &'a State,
+    /// Integrator step index of the frame.
+    pub step: u64,
+    /// Contact points of every pair with their forces, indexed by pair id.
+    /// Evaluated once per frame and shared by every table; empty lists when
+    /// no table asked for contacts.
+    pub contacts: &'a [Vec<ContactEval>],
+}
+
+/// A producer of output tables, registered with a simulation by a layer
+/// above the engine.
+pub trait Observer: Debug + Send + Sync {
+    /// The tables it fills, in order; fixed for the observer's lifetime.
+    fn tables(&self) -> Vec<&'static TableDef>;
+
+    /// Whether it reads [`Frame::contacts`].
+    fn needs_contacts(&self) -> bool;
+
+    /// Appends the rows of one frame; `out[i]` is the buffer of `tables()[i]`.
+    fn record(&mut self, frame: &Frame<'_>, out: &mut [TableBuffer]);
+
+    /// A boxed copy (simulations are cloneable).
+    fn clone_box(&self) -> Box<dyn Observer>;
+}
+
+impl Clone for Box<dyn Observer> {
+    fn clone(&self) -> Self {
+        self.clone_box()
+    }
+}
+
+/// Total normal force [N] and magnitude of the summed friction force [N] of
+/// every point of the pairs `pairs` (pair ids into `contacts`).
+pub fn contact_totals(contacts: &[Vec<ContactEval>], pairs: &[usize]) -> (f64, f64) {
+    let mut n = 0.0;
+    let mut f = Vec3::zeros();
+    for &k in pairs {
+        for e in &contacts[k] {
+            n += e.normal_force;
+            f += e.tangential_force;
+        }
+    }
+    (n, f.norm())
+}

@@ -1,0 +1,52 @@
+"""The paper's run: Zhu et al., *Machines* 2023, 11, 357, reproduced and compared.
+
+`run_paper` runs the embedded drill-pipe scene (`ballcage.default_scene`) with
+every table recorded, and writes into one directory:
+
+- ``<table>.parquet`` and ``scene.toml`` (`Run.write`);
+- the paper's figures as PNG: ``fig09_included_angles``, ``fig10_tube_normal``,
+  ``fig11_tube_tangential``, ``fig12_key_normal``, ``fig13_key_tangential``
+  and ``table3_shape``;
+- ``comparison.parquet`` and ``comparison.md``: one row per ``[[quantity]]``
+  of the shipped reference file ``ballcage/data/paper-2023.toml``, with the
+  paper's value, ours, their ratio and a note on how our definition differs
+  and on values the paper itself contradicts (``suspect``).
+
+With ``sweeps=True`` it also runs the curvature (R = 1.0, 2.5 m) and speed
+(60, 120 rpm) variants of §4.2–4.3 and fills the ``sweep_*`` rows.
+
+`comparison(run)` builds the comparison table from any run of the paper scene,
+so it can be checked on a short run. Everything is computed from the recorded
+tables (``links``, ``hinges``, ``keys``) and the scene's own values
+(`Run.scene`); the definitions are in `DEFINITIONS` and are repeated in each
+row's note.
+
+Modules, one job each: `running` (the scenes and `run_paper`), `definitions`
+(the reference file and how each quantity is computed), `facts` (scene values
+and Table 3's phases), `frames` (per-frame grids of the tables), `compare` (the
+comparison table), `markdown` (``comparison.md``), `figures` (the PNGs).
+"""
+
+from ballcage.paper.compare import COMPARISON_SCHEMA, comparison
+from ballcage.paper.definitions import SWEEPS, TUBE_LINKS, reference
+from ballcage.paper.facts import PHASES
+from ballcage.paper.figures import FIGURES, KEY_BODIES, write_figures
+from ballcage.paper.markdown import comparison_markdown
+from ballcage.paper.running import PAPER_TABLES, SWEEP_TABLES, paper_scene, run_paper
+
+__all__ = [
+    "COMPARISON_SCHEMA",
+    "FIGURES",
+    "KEY_BODIES",
+    "PAPER_TABLES",
+    "PHASES",
+    "SWEEPS",
+    "SWEEP_TABLES",
+    "TUBE_LINKS",
+    "comparison",
+    "comparison_markdown",
+    "paper_scene",
+    "reference",
+    "run_paper",
+    "write_figures",
+]

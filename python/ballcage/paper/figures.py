@@ -1,0 +1,216 @@
+"""The paper's figures (Figs. 9–13 and Table 3's chain shape) drawn from a run's tables."""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ballcage._files import write_png
+from ballcage._plot import colormap, figure, no_data
+from ballcage.paper.definitions import TUBE_LINKS
+from ballcage.paper.facts import SceneFacts, phases, scene_facts
+from ballcage.paper.frames import frame_grid, frame_times
+from ballcage.run import Run
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["FIGURES", "KEY_BODIES", "write_figures"]
+
+#: Figure files (without ``.png``), in the order they are written.
+FIGURES: tuple[str, ...] = (
+    "fig09_included_angles",
+    "fig10_tube_normal",
+    "fig11_tube_tangential",
+    "fig12_key_normal",
+    "fig13_key_tangential",
+    "table3_shape",
+)
+#: Bodies whose ball-key forces the paper plots (Figs. 12–13): connectors and links.
+KEY_BODIES: tuple[str | int, ...] = ("upper", 1, 3, 6, 9, 12, "lower")
+
+
+def write_figures(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
+    """Writes the paper's figures (`FIGURES`) as PNG into `out_dir`; returns their paths by name."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    facts = scene_facts(run)
+    times = frame_times(run)
+    makers: dict[str, Callable[[], Figure]] = {
+        "fig09_included_angles": lambda: _fig_included_angles(run, facts, times),
+        "fig10_tube_normal": lambda: _fig_tube(run, times, normal=True),
+        "fig11_tube_tangential": lambda: _fig_tube(run, times, normal=False),
+        "fig12_key_normal": lambda: _fig_keys(run, times, normal=True),
+        "fig13_key_tangential": lambda: _fig_keys(run, times, normal=False),
+        "table3_shape": lambda: _fig_shape(run, facts, times),
+    }
+    return {name: write_png(makers[name](), out / f"{name}.png") for name in FIGURES}
+
+
+def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
+    fig = figure(figsize=(11, 4.5))
+    by_link, over_time = fig.subplots(1, 2)
+    links = run.tables.get("links")
+    found, skipped = phases(run, facts)
+    if links is not None and links.num_rows:
+        grid = frame_grid(links, times, ["link"], ["included_angle_deg"])["included_angle_deg"][:, 1:]
+        numbers = np.arange(1, grid.shape[1] + 1)
+        for p in found:
+            by_link.plot(numbers, grid[p.frame], marker="o", label=f"{p.label} (t = {p.t:.3f} s)")
+        by_link.set_xticks(numbers)
+        cmap = colormap("viridis")
+        for k in range(grid.shape[1]):
+            over_time.plot(times, grid[:, k], color=cmap(k / max(grid.shape[1] - 1, 1)), lw=1, label=f"link {k + 1}")
+        over_time.legend(fontsize=7, ncol=2, loc="best")
+    else:
+        no_data(over_time, "no links table")
+    if found:
+        by_link.legend(fontsize=8, title="phase of the upper connector", title_fontsize=8)
+    if skipped:
+        by_link.text(
+            0.01, 0.01, f"phases before t = 0 not shown: {', '.join(skipped)}", transform=by_link.transAxes, fontsize=7
+        )
+    by_link.set(
+        xlabel="link number k [-]",
+        ylabel="included angle, link k / body k+1 [deg]",
+        title="At the four phases of the last revolution",
+    )
+    over_time.set(xlabel="time [s]", ylabel="included angle, link k / body k+1 [deg]", title="Over time")
+    fig.suptitle("Fig. 9: angle between adjacent links (180 deg = straight)")
+    return fig
+
+
+def _fig_tube(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
+    fig = figure(figsize=(9, 4.8))
+    ax = fig.subplots()
+    kind = "normal" if normal else "tangential"
+    column = f"tube_{kind}"
+    links = run.tables.get("links")
+    if links is not None and links.num_rows:
+        forces = frame_grid(links, times, ["link"], [column])[column]
+        for k in TUBE_LINKS:
+            if k < forces.shape[1]:
+                ax.plot(times, forces[:, k], lw=1, label=f"link {k}")
+        ax.legend(title=f"links.{column}", fontsize=8)
+    else:
+        no_data(ax, "no links table")
+    ax.set(xlabel="time [s]", ylabel=f"{kind} contact force link-tube [N]")
+    detail = "sum over the contact points" if normal else "magnitude of the summed friction vector"
+    number = 10 if normal else 11
+    ax.set_title(f"Fig. {number}: {kind} force between links 2, 4, 6, 8, 10 and the guide tube\n(per frame: {detail})")
+    return fig
+
+
+def _key_races(joints: int) -> dict[str | int, list[tuple[int, str]]]:
+    """For each plotted body, its races as (hinge, keys column prefix): head = inner race, seat = outer race."""
+    races: dict[str | int, list[tuple[int, str]]] = {}
+    for body in KEY_BODIES:
+        if body == "upper":
+            races[body] = [(0, "inner")]
+        elif body == "lower":
+            races[body] = [(joints, "outer")]
+        else:
+            assert isinstance(body, int)
+            races[body] = [(body - 1, "outer"), (body, "inner")]
+    return races
+
+
+def _race_label(body: str | int, races: list[tuple[int, str]]) -> str:
+    name = f"link {body}" if isinstance(body, int) else f"{body} connector"
+    parts = [f"h{h:02d} {'seat (outer)' if side == 'outer' else 'head (inner)'} race" for h, side in races]
+    return f"{name}: {parts[0]}" if len(parts) == 1 else f"{name}: max of {' and '.join(parts)}"
+
+
+def _fig_keys(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
+    fig = figure(figsize=(10, 5.2))
+    ax = fig.subplots()
+    keys = run.tables.get("keys")
+    kind = "normal" if normal else "tangential"
+    if keys is not None and keys.num_rows:
+        cols = [f"{side}_{kind}" for side in ("inner", "outer")]
+        grids = frame_grid(keys, times, ["hinge", "key"], cols)
+        joints = grids[cols[0]].shape[1] - 1
+        for body, races in _key_races(joints).items():
+            series = [grids[f"{side}_{kind}"][:, h, :] for h, side in races if 0 <= h <= joints]
+            if not series:
+                continue
+            largest = np.nanmax(np.concatenate(series, axis=1), axis=1)
+            ax.plot(times, largest, lw=1, label=_race_label(body, races))
+        ax.legend(fontsize=7, loc="best")
+    else:
+        no_data(ax, "no keys table")
+    ax.set(xlabel="time [s]", ylabel=f"largest ball-key {kind} force [N]")
+    number = 12 if normal else 13
+    column = "inner/outer_" + kind
+    ax.set_title(
+        f"Fig. {number}: ball-key {kind} force on the races of the connectors and links 1, 3, 6, 9, 12\n"
+        f"per frame, the largest keys.{column} of the 6 keys over the body's races "
+        "(link k: seat race of hinge k-1, head race of hinge k)",
+        fontsize=9,
+    )
+    return fig
+
+
+def _fig_shape(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
+    fig = figure(figsize=(12, 7.5))
+    grid_spec = fig.add_gridspec(2, 4, height_ratios=[1.1, 1])
+    sections = [fig.add_subplot(grid_spec[0, i]) for i in range(4)]
+    profile = fig.add_subplot(grid_spec[1, :])
+    links = run.tables.get("links")
+    found, _ = phases(run, facts)
+    by_label = {p.label: p for p in found}
+    clearance_mm = 1e3 * facts.clearance
+    if links is not None and links.num_rows:
+        g = frame_grid(links, times, ["link"], ["offset_outward", "offset_lateral", "radial_offset"])
+        outward, lateral = g["offset_outward"][:, 1:], g["offset_lateral"][:, 1:]
+        offsets = g["radial_offset"][:, 1:]
+        numbers = np.arange(1, offsets.shape[1] + 1)
+        for ax, (label, t) in zip(sections, facts.phase_times(), strict=True):
+            p = by_label.get(label)
+            _section_axes(ax, clearance_mm)
+            if p is None:
+                ax.set_title(f"{label}: t = {t:.3f} s not in run", fontsize=9)
+                continue
+            x_mm, y_mm = 1e3 * outward[p.frame], 1e3 * lateral[p.frame]
+            sc = ax.scatter(x_mm, y_mm, c=numbers, cmap="viridis", s=22, zorder=3)
+            for k, x, y in zip(numbers, x_mm, y_mm, strict=True):
+                ax.annotate(str(k), (x, y), fontsize=6, xytext=(2, 2), textcoords="offset points")
+            ax.set_title(f"{label}: t = {p.t:.3f} s, max link {p.most_deformed}", fontsize=9)
+            profile.plot(numbers, 1e3 * offsets[p.frame], marker="o", label=f"{label} (t = {p.t:.3f} s)")
+        if found:
+            fig.colorbar(sc, ax=sections, label="link number [-]", shrink=0.8)
+        profile.set_xticks(numbers)
+    else:
+        no_data(profile, "no links table")
+    profile.axhline(clearance_mm, color="k", ls="--", lw=0.8, label=f"clearance {clearance_mm:.0f} mm")
+    profile.set(
+        xlabel="link number k [-]",
+        ylabel="centre offset from tube centreline [mm]",
+        title="Radial offset of each link's centre of mass (links.radial_offset)",
+    )
+    profile.legend(fontsize=8)
+    fig.suptitle(
+        "Table 3: chain shape at the phases 0/90/180/270 deg of the upper connector's last revolution "
+        f"({facts.rpm:g} rpm; dashed circle: tube clearance {clearance_mm:.0f} mm)",
+        fontsize=10,
+    )
+    return fig
+
+
+def _section_axes(ax: Axes, clearance_mm: float) -> None:
+    """A tube cross-section [mm]: the clearance circle, equal axes, + toward the outer wall of the bend."""
+    circle = np.linspace(0.0, 2.0 * math.pi, 181)
+    ax.plot(clearance_mm * np.cos(circle), clearance_mm * np.sin(circle), "k--", lw=0.8)
+    ax.set_aspect("equal")
+    ax.set(
+        xlabel="links.offset_outward [mm]\n(in the bend plane, + toward the outer wall)",
+        ylabel="links.offset_lateral [mm]",
+        xlim=(-1.15 * clearance_mm, 1.15 * clearance_mm),
+        ylim=(-1.15 * clearance_mm, 1.15 * clearance_mm),
+    )
