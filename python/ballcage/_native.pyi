@@ -24,7 +24,7 @@ __all__ = [
     "whole_multiple",
 ]
 
-_TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"]
+_TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive", "pairs"]
 
 __version__: str
 #: Cargo profile the extension was built with; "debug" runs ~10x slower.

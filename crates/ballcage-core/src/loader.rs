@@ -257,3 +257,46 @@ pub fn table(name: &str) -> Option<&'static TableDef> {
 pub fn default_document() -> DrillPipeSpec {
     DrillPipeSpec::default()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::record::ColumnKind;
+
+    #[test]
+    fn every_table_has_a_unique_name_and_unique_columns_with_units() {
+        let all = tables();
+        for (i, t) in all.iter().enumerate() {
+            assert!(
+                all[..i].iter().all(|o| o.name != t.name),
+                "{} twice",
+                t.name
+            );
+            for (j, c) in t.columns.iter().enumerate() {
+                assert!(
+                    t.columns[..j].iter().all(|o| o.name != c.name),
+                    "{}.{} twice",
+                    t.name,
+                    c.name
+                );
+                if c.kind == ColumnKind::F64 {
+                    assert!(!c.unit.is_empty(), "{}.{} has no unit", t.name, c.name);
+                }
+            }
+        }
+        assert_eq!(table("links").map(|t| t.name), Some("links"));
+        assert!(table("nonsense").is_none());
+    }
+
+    #[test]
+    fn the_kind_is_declared_or_implied_by_the_sections() {
+        let kind = |text: &str| Kind::of(&parse_toml(text).unwrap());
+        assert_eq!(kind("kind = \"drill-pipe\"").unwrap(), Kind::DrillPipe);
+        assert_eq!(kind("[pipe]\njoints = 3").unwrap(), Kind::DrillPipe);
+        assert_eq!(kind("bodies = []").unwrap(), Kind::Generic);
+        assert_eq!(kind("kind = \"generic\"\n[pipe]").unwrap(), Kind::Generic);
+        let e = kind("kind = \"crane\"").unwrap_err();
+        assert_eq!(e.path, "kind");
+        assert!(e.reason.contains("\"drill-pipe\""), "{e}");
+    }
+}

@@ -3,6 +3,7 @@
 mod common;
 
 use ballcage_core::force::joint::twist_angle;
+use ballcage_core::record::ColumnData;
 use ballcage_core::{Document, Simulation};
 
 const K_SI: f64 = 1e5 * 3.981_071_705_534_972e6; // 1e5 N/mm^2.2 in N/m^2.2 (1000^2.2 = 10^6.6)
@@ -545,4 +546,64 @@ fn link_tube_forces_are_the_sums_of_each_links_contact_rows() {
         touching > 0,
         "no link touches the tube: the check would be empty"
     );
+}
+
+#[test]
+fn the_pairs_table_says_what_each_pair_touches() {
+    // 12 tube pairs; per hinge (13) one cage–head and one cage–seat pair and
+    // per key (6) two flanks on each race and two window pairs.
+    let o: Vec<String> = ["simulation.duration=1e-4", "record.tables=[\"pairs\"]"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &o).unwrap();
+    let rec = doc.simulation().finish();
+    let t = rec.tables.iter().find(|t| t.def.name == "pairs").unwrap();
+    assert_eq!(t.rows, doc.scene().contacts.len());
+    let (feature, link, hinge, key) = match (
+        t.column("feature"),
+        t.column("link"),
+        t.column("hinge"),
+        t.column("key"),
+    ) {
+        (
+            Some(ColumnData::U32(f)),
+            Some(ColumnData::OptU32(l)),
+            Some(ColumnData::OptU32(h)),
+            Some(ColumnData::OptU32(k)),
+        ) => (f, l, h, k),
+        other => panic!("pairs columns: {other:?}"),
+    };
+    let labels = ballcage_core::drillpipe::Feature::LABELS;
+    let count = |label: &str| {
+        feature
+            .iter()
+            .filter(|&&f| labels[f as usize] == label)
+            .count()
+    };
+    assert_eq!(count("tube"), 12);
+    assert_eq!((count("cage-head"), count("cage-seat")), (13, 13));
+    assert_eq!(
+        (count("inner-race"), count("outer-race")),
+        (13 * 12, 13 * 12)
+    );
+    assert_eq!(count("window"), 13 * 12);
+    // A tube pair's link is the chain position of its body b; joint pairs
+    // name a hinge and no link; key pairs a key 0–5.
+    let (_, layout) = doc.drill_pipe_parts().unwrap();
+    for (k, pair) in doc.model().pairs.iter().enumerate() {
+        match labels[feature[k] as usize] {
+            "tube" => {
+                let link = link[k].expect("tube pair has a link") as usize;
+                assert_eq!(layout.chain[link], pair.b, "pair {k}");
+                assert_eq!(hinge[k], None);
+            }
+            label => {
+                assert_eq!(link[k], None, "pair {k}");
+                assert!(hinge[k].is_some_and(|h| h <= 12), "pair {k}");
+                let keyed = ["inner-race", "outer-race", "window"].contains(&label);
+                assert_eq!(key[k].is_some_and(|j| j < 6), keyed, "pair {k}");
+            }
+        }
+    }
 }

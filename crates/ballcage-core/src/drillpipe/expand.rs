@@ -10,7 +10,7 @@
 //! window faces.
 
 use super::cv::CvGeometry;
-use super::layout::{HingeLayout, KeyLayout, Layout};
+use super::layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
 use super::spec::{DrillPipeSpec, HingeModel, MaterialSpec};
 use super::{chain, names};
 use crate::error::SceneError;
@@ -187,6 +187,7 @@ impl<'a> Builder<'a> {
             layout: Layout {
                 chain: vec![],
                 tube_pairs: vec![],
+                pairs: vec![],
                 hinges: vec![],
                 centreline: place.centreline.clone(),
                 lateral: -BEND_NORMAL,
@@ -208,8 +209,9 @@ impl<'a> Builder<'a> {
         self.bodies.len() - 1
     }
 
-    fn push_contact(&mut self, contact: ContactSpec) -> usize {
+    fn push_contact(&mut self, contact: ContactSpec, part: PairPart) -> usize {
         self.contacts.push(contact);
+        self.layout.pairs.push(part);
         self.contacts.len() - 1
     }
 
@@ -295,7 +297,11 @@ impl<'a> Builder<'a> {
                 geometry: None,
                 points: self.spec.pipe.tube_contact_points,
             };
-            let id = self.push_contact(contact);
+            let part = PairPart {
+                link: Some(k as u32),
+                ..PairPart::of(Feature::Tube)
+            };
+            let id = self.push_contact(contact, part);
             self.layout.tube_pairs.push(id);
         }
     }
@@ -365,7 +371,13 @@ impl<'a> Builder<'a> {
     }
 
     /// A contact of the joint's internal material between two parts.
-    fn internal_contact(&mut self, name: String, a: &str, b: &str, geometry: FeatureSpec) -> usize {
+    fn internal_contact(
+        &mut self,
+        name: String,
+        [a, b]: [&str; 2],
+        geometry: FeatureSpec,
+        part: PairPart,
+    ) -> usize {
         let MaterialSpec { normal, friction } = &self.spec.materials.internal;
         let contact = ContactSpec {
             name: Some(name),
@@ -375,7 +387,7 @@ impl<'a> Builder<'a> {
             geometry: Some(geometry),
             points: 5,
         };
-        self.push_contact(contact)
+        self.push_contact(contact, part)
     }
 
     /// The cage's spherical contacts with the ball head and the ball seat.
@@ -395,10 +407,22 @@ impl<'a> Builder<'a> {
             sphere_centre: [0.0; 3],
             sphere_radius: kb.cage_outer_radius,
         };
-        let cage_head =
-            self.internal_contact(names::feature(&cage, "head"), &cage, head, head_geometry);
-        let cage_seat =
-            self.internal_contact(names::feature(&cage, "seat"), seat, &cage, seat_geometry);
+        let part = |feature| PairPart {
+            hinge: Some(h as u32),
+            ..PairPart::of(feature)
+        };
+        let cage_head = self.internal_contact(
+            names::feature(&cage, "head"),
+            [&cage, head],
+            head_geometry,
+            part(Feature::CageHead),
+        );
+        let cage_seat = self.internal_contact(
+            names::feature(&cage, "seat"),
+            [seat, &cage],
+            seat_geometry,
+            part(Feature::CageSeat),
+        );
         HingeLayout {
             cage_head: Some(cage_head),
             cage_seat: Some(cage_seat),
@@ -415,11 +439,10 @@ impl<'a> Builder<'a> {
             groove_offset: kb.groove_offset,
         };
         let psi = j as f64 * std::f64::consts::FRAC_PI_3;
-        let key = names::key(h, j);
         let key_inertia = 0.4 * kb.ball_mass * kb.ball_radius * kb.ball_radius;
         let p_hinge = cv.ball_centre_in_groove(beta, psi);
         let body = BodySpec {
-            name: key.clone(),
+            name: names::key(h, j),
             motion: MotionKind::Dynamic,
             shape: ShapeSpec::Ball {
                 radius: kb.ball_radius,
@@ -431,12 +454,32 @@ impl<'a> Builder<'a> {
         };
         self.push_body(body);
         let mut layout = KeyLayout::default();
+        self.race_flanks(h, j, [head, seat], &mut layout);
+        self.window_faces(h, j, &mut layout);
+        layout
+    }
+
+    /// Key `j`'s tangent direction in the hinge frame: the normal of its
+    /// groove's plane and of its window's side faces.
+    fn key_tangent(j: usize) -> Vec3 {
+        let psi = j as f64 * std::f64::consts::FRAC_PI_3;
+        Vec3::new(0.0, -psi.sin(), psi.cos())
+    }
+
+    /// The two Gothic-arch flanks of key `j`'s groove in the head and in the seat.
+    fn race_flanks(&mut self, h: usize, j: usize, [head, seat]: [&str; 2], layout: &mut KeyLayout) {
+        let kb = &self.spec.pipe.ball_keys;
+        let cv = CvGeometry {
+            pitch_radius: kb.pitch_radius,
+            groove_offset: kb.groove_offset,
+        };
+        let key = names::key(h, j);
         let (c_head, c_seat) = self.hinge_anchors(h);
         let rho = cv.track_radius();
         let alpha = kb.contact_angle_deg.to_radians();
         let a = kb.groove_radius - kb.ball_radius - kb.flank_clearance;
-        let e_t = Vec3::new(0.0, -psi.sin(), psi.cos());
-        for (sign, tag) in [(1.0, "+"), (-1.0, "-")] {
+        let e_t = Self::key_tangent(j);
+        for (face, sign, tag) in [(0, 1.0, "+"), (1, -1.0, "-")] {
             let head_flank = FeatureSpec::TorusBall {
                 centre: arr(&(c_head - kb.groove_offset * Vec3::x() + sign * a * alpha.sin() * e_t)),
                 axis: arr(&e_t),
@@ -452,31 +495,42 @@ impl<'a> Builder<'a> {
                 tube_radius: kb.groove_radius,
             };
             let name = names::feature(&key, &format!("head{tag}"));
+            let inner = key_part(Feature::InnerRace, h, j, face);
             layout
                 .inner
-                .push(self.internal_contact(name, head, &key, head_flank));
+                .push(self.internal_contact(name, [head, &key], head_flank, inner));
             let name = names::feature(&key, &format!("seat{tag}"));
+            let outer = key_part(Feature::OuterRace, h, j, face);
             layout
                 .outer
-                .push(self.internal_contact(name, seat, &key, seat_flank));
+                .push(self.internal_contact(name, [seat, &key], seat_flank, outer));
         }
-        let cage = names::cage(h);
+    }
+
+    /// The axial and side faces of key `j`'s cage window.
+    fn window_faces(&mut self, h: usize, j: usize, layout: &mut KeyLayout) {
+        let kb = &self.spec.pipe.ball_keys;
+        let (key, cage) = (names::key(h, j), names::cage(h));
         let windows = [
             ("window-axial", [1.0, 0.0, 0.0], kb.window_axial_width / 2.0),
-            ("window-side", arr(&e_t), kb.window_length / 2.0),
+            (
+                "window-side",
+                arr(&Self::key_tangent(j)),
+                kb.window_length / 2.0,
+            ),
         ];
-        for (tag, normal, half_width) in windows {
+        for (face, (tag, normal, half_width)) in (0..).zip(windows) {
             let slot = FeatureSpec::SlotBall {
                 centre: [0.0; 3],
                 normal,
                 half_width,
             };
             let name = names::feature(&key, tag);
+            let window = key_part(Feature::Window, h, j, face);
             layout
                 .window
-                .push(self.internal_contact(name, &cage, &key, slot));
+                .push(self.internal_contact(name, [&cage, &key], slot, window));
         }
-        layout
     }
 
     /// The generic scene: the parts plus gravity, the resisting moment and recording.
@@ -516,6 +570,16 @@ impl<'a> Builder<'a> {
             scene,
             layout: self.layout,
         }
+    }
+}
+
+/// A pair of key `j` of hinge `h` on face `face` of `feature`.
+fn key_part(feature: Feature, h: usize, j: usize, face: u32) -> PairPart {
+    PairPart {
+        hinge: Some(h as u32),
+        key: Some(j as u32),
+        face: Some(face),
+        ..PairPart::of(feature)
     }
 }
 

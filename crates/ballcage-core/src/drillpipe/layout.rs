@@ -5,6 +5,69 @@
 use crate::geometry::{CentrelinePoint, TubePath};
 use crate::math::Vec3;
 
+/// What a contact pair of the drill pipe touches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Feature {
+    /// A link against the guide tube.
+    Tube,
+    /// The cage's inner sphere on the ball head.
+    CageHead,
+    /// The cage's outer sphere in the ball seat.
+    CageSeat,
+    /// A ball key on a flank of its groove in the ball head (inner race).
+    InnerRace,
+    /// A ball key on a flank of its groove in the ball seat (outer race).
+    OuterRace,
+    /// A ball key on a face of its cage window.
+    Window,
+}
+
+impl Feature {
+    /// Labels in the order of the variants (the `pairs.feature` dictionary).
+    pub const LABELS: &'static [&'static str] = &[
+        "tube",
+        "cage-head",
+        "cage-seat",
+        "inner-race",
+        "outer-race",
+        "window",
+    ];
+
+    /// Index into [`Feature::LABELS`].
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+}
+
+/// Which part of the pipe a contact pair belongs to; ids that do not apply are `None`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PairPart {
+    /// What it touches.
+    pub feature: Feature,
+    /// Link number, 1 at the top (tube pairs).
+    pub link: Option<u32>,
+    /// Hinge number, 0 above link 1 (joint pairs).
+    pub hinge: Option<u32>,
+    /// Ball key number, 0–5 (key pairs).
+    pub key: Option<u32>,
+    /// Which face of the feature: for a race 0 the `+` flank and 1 the `−`
+    /// flank; for a window 0 the axial faces and 1 the side faces.
+    pub face: Option<u32>,
+}
+
+impl PairPart {
+    /// A pair of feature `feature` with no ids set.
+    pub fn of(feature: Feature) -> Self {
+        Self {
+            feature,
+            link: None,
+            hinge: None,
+            key: None,
+            face: None,
+        }
+    }
+}
+
 /// Pair ids of one ball key.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct KeyLayout {
@@ -34,6 +97,8 @@ pub struct Layout {
     pub chain: Vec<usize>,
     /// Pair id of link k's contact with the tube at index k − 1.
     pub tube_pairs: Vec<usize>,
+    /// What each contact pair is, indexed by pair id.
+    pub pairs: Vec<PairPart>,
     /// Hinges 0…n; hinge k joins chain bodies k and k + 1.
     pub hinges: Vec<HingeLayout>,
     /// The tube centreline, extended straight past the arc [m].

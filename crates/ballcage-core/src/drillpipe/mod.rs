@@ -30,7 +30,7 @@ mod spec;
 pub mod tables;
 
 pub use expand::Expansion;
-pub use layout::{HingeLayout, KeyLayout, Layout};
+pub use layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
 pub use spec::{
     BallKeySpec, BoreholeSpec, DrillPipeSpec, DriveSpec, GravitySpec, HingeModel, IdealCvSpec,
     KIND, MaterialSpec, MaterialsSpec, PipeRecordSpec, PipeSpec, PipeTable, ResistingMomentSpec,

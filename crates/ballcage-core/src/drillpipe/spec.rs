@@ -376,6 +376,8 @@ pub enum PipeTable {
     Keys,
     /// Per frame: input/output torque, speed, power and efficiency.
     Drive,
+    /// Once per run: what each contact pair is (feature, link, hinge, key, face).
+    Pairs,
 }
 
 impl PipeTable {
@@ -386,7 +388,7 @@ impl PipeTable {
             Self::Contacts => Some(TableKind::Contacts),
             Self::Energy => Some(TableKind::Energy),
             Self::Summary => Some(TableKind::Summary),
-            Self::Links | Self::Hinges | Self::Keys | Self::Drive => None,
+            Self::Links | Self::Hinges | Self::Keys | Self::Drive | Self::Pairs => None,
         }
     }
 }
@@ -402,6 +404,7 @@ impl TableChoice for PipeTable {
             Self::Hinges => "hinges",
             Self::Keys => "keys",
             Self::Drive => "drive",
+            Self::Pairs => "pairs",
             engine => engine.engine().map_or("", TableKind::name),
         }
     }

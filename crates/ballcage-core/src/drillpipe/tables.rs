@@ -3,7 +3,7 @@
 //! `keys` and `drive`. Parts are identified by integer columns (`link`,
 //! `hinge`, `key`), never by names.
 
-use super::layout::Layout;
+use super::layout::{Feature, Layout};
 use super::spec::PipeTable;
 use crate::math::{Vec3, angle_between};
 use crate::model::Motion;
@@ -12,7 +12,7 @@ use crate::record::{
     col, contact_totals,
 };
 
-use ColumnKind::{F64, Name, U32};
+use ColumnKind::{F64, Name, OptU32, U32};
 
 /// Columns of the `links` table (drill pipe): one row per link per frame.
 const LINKS_COLUMNS: &[ColumnDef] = &[
@@ -198,6 +198,47 @@ const DRIVE_COLUMNS: &[ColumnDef] = &[
     ),
 ];
 
+/// Columns of the `pairs` table (drill pipe): one row per contact pair, written once.
+const PAIRS_COLUMNS: &[ColumnDef] = &[
+    col(
+        "pair_id",
+        U32,
+        "",
+        "contact pair index in the scene's contact list (the contacts and summary tables' pair_id)",
+    ),
+    col("pair", Name(Dictionary::Pairs), "", "contact pair name"),
+    col(
+        "feature",
+        Name(Dictionary::Labels(Feature::LABELS)),
+        "",
+        "what the pair touches: tube, cage-head, cage-seat, inner-race, outer-race or window",
+    ),
+    col(
+        "link",
+        OptU32,
+        "",
+        "link number, 1 at the top (tube pairs; null otherwise)",
+    ),
+    col(
+        "hinge",
+        OptU32,
+        "",
+        "hinge number, 0 above link 1 (joint pairs; null otherwise)",
+    ),
+    col(
+        "key",
+        OptU32,
+        "",
+        "ball key number, 0-5 (key pairs; null otherwise)",
+    ),
+    col(
+        "face",
+        OptU32,
+        "",
+        "race flank (0 the + flank, 1 the - flank) or window faces (0 axial, 1 side); null otherwise",
+    ),
+];
+
 /// The `links` table.
 pub const LINKS: TableDef = TableDef {
     name: "links",
@@ -223,8 +264,15 @@ pub const DRIVE: TableDef = TableDef {
     columns: DRIVE_COLUMNS,
 };
 
+/// The `pairs` table.
+pub const PAIRS: TableDef = TableDef {
+    name: "pairs",
+    row: "one row per contact pair, written with the first frame",
+    columns: PAIRS_COLUMNS,
+};
+
 /// The drill pipe's tables, in the order `ballcage schema` lists them.
-pub const TABLES: [&TableDef; 4] = [&LINKS, &HINGES, &KEYS, &DRIVE];
+pub const TABLES: [&TableDef; 5] = [&LINKS, &HINGES, &KEYS, &DRIVE, &PAIRS];
 
 /// The drill pipe's own table of a `record.tables` entry, if it is one.
 pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
@@ -233,6 +281,7 @@ pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
         PipeTable::Hinges => Some(&HINGES),
         PipeTable::Keys => Some(&KEYS),
         PipeTable::Drive => Some(&DRIVE),
+        PipeTable::Pairs => Some(&PAIRS),
         PipeTable::Bodies | PipeTable::Contacts | PipeTable::Energy | PipeTable::Summary => None,
     }
 }
@@ -263,7 +312,7 @@ impl Observer for PipeTables {
     }
 
     fn needs_contacts(&self) -> bool {
-        !self.tables.is_empty()
+        self.tables.iter().any(|t| *t != PipeTable::Pairs)
     }
 
     fn record(&mut self, frame: &Frame<'_>, out: &mut [TableBuffer]) {
@@ -273,6 +322,7 @@ impl Observer for PipeTables {
                 PipeTable::Hinges => hinges(table, &self.layout, frame),
                 PipeTable::Keys => keys(table, &self.layout, frame),
                 PipeTable::Drive => drive(table, &self.layout, frame),
+                PipeTable::Pairs => pairs(table, &self.layout),
                 _ => {}
             }
         }
@@ -280,6 +330,24 @@ impl Observer for PipeTables {
 
     fn clone_box(&self) -> Box<dyn Observer> {
         Box::new(self.clone())
+    }
+}
+
+/// The `pairs` rows, once: with the first frame recorded.
+fn pairs(table: &mut TableBuffer, layout: &Layout) {
+    if table.rows > 0 {
+        return;
+    }
+    for (k, p) in layout.pairs.iter().enumerate() {
+        table.push(&[
+            Cell::U32(k as u32),
+            Cell::U32(k as u32),
+            Cell::U32(p.feature.code()),
+            Cell::OptU32(p.link),
+            Cell::OptU32(p.hinge),
+            Cell::OptU32(p.key),
+            Cell::OptU32(p.face),
+        ]);
     }
 }
 

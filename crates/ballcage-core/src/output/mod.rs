@@ -27,6 +27,7 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
                 ColumnKind::U64 => DataType::UInt64,
                 ColumnKind::U32 => DataType::UInt32,
                 ColumnKind::F64 => DataType::Float64,
+                ColumnKind::OptU32 => DataType::UInt32,
                 ColumnKind::Name(_) => {
                     DataType::Dictionary(Box::new(DataType::UInt32), Box::new(DataType::Utf8))
                 }
@@ -34,7 +35,7 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
             let mut md = HashMap::new();
             md.insert("unit".to_string(), c.unit.to_string());
             md.insert("description".to_string(), c.description.to_string());
-            Field::new(c.name, dt, false).with_metadata(md)
+            Field::new(c.name, dt, c.kind == ColumnKind::OptU32).with_metadata(md)
         })
         .collect();
     Schema::new_with_metadata(fields, metadata)
@@ -59,10 +60,14 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBa
                     (ColumnKind::U64, ColumnData::U64(v)) => Arc::new(UInt64Array::from(v)),
                     (ColumnKind::U32, ColumnData::U32(v)) => Arc::new(UInt32Array::from(v)),
                     (ColumnKind::F64, ColumnData::F64(v)) => Arc::new(Float64Array::from(v)),
+                    (ColumnKind::OptU32, ColumnData::OptU32(v)) => Arc::new(UInt32Array::from(v)),
                     (ColumnKind::Name(dict), ColumnData::U32(v)) => {
                         let values = match dict {
                             Dictionary::Bodies => bodies.clone(),
                             Dictionary::Pairs => pairs.clone(),
+                            Dictionary::Labels(labels) => {
+                                Arc::new(StringArray::from_iter_values(labels.iter()))
+                            }
                         };
                         Arc::new(DictionaryArray::<UInt32Type>::try_new(
                             UInt32Array::from(v),

@@ -25,7 +25,10 @@ pub enum ColumnKind {
     U32,
     /// 64-bit float.
     F64,
-    /// A name, dictionary-encoded with u32 keys into [`TableBuffer::dictionaries`].
+    /// Unsigned 32-bit integer, or null where the column does not apply to
+    /// the row (an id of a part the row has none of).
+    OptU32,
+    /// A name, dictionary-encoded with u32 keys into a [`Dictionary`].
     Name(Dictionary),
 }
 
@@ -36,6 +39,8 @@ pub enum Dictionary {
     Bodies,
     /// Contact pair names, indexed by pair id.
     Pairs,
+    /// A fixed list of labels, indexed by position.
+    Labels(&'static [&'static str]),
 }
 
 /// One column: name, type, unit, meaning.
@@ -77,7 +82,7 @@ pub const fn col(
     }
 }
 
-use ColumnKind::{F64, Name, U32, U64};
+use ColumnKind::{F64, Name, OptU32, U32, U64};
 
 /// The frame's integrator step index, first column of every per-frame table.
 pub const STEP: ColumnDef = col("step", U64, "", "integrator step index of the frame");
@@ -343,6 +348,8 @@ pub enum Cell {
     U32(u32),
     /// For `F64` columns.
     F64(f64),
+    /// For `OptU32` columns.
+    OptU32(Option<u32>),
 }
 
 /// Column data.
@@ -354,6 +361,8 @@ pub enum ColumnData {
     U32(Vec<u32>),
     /// f64 values.
     F64(Vec<f64>),
+    /// u32 values or nulls.
+    OptU32(Vec<Option<u32>>),
 }
 
 /// Columnar buffers of one table.
@@ -377,6 +386,7 @@ impl TableBuffer {
                 U64 => ColumnData::U64(Vec::new()),
                 U32 | Name(_) => ColumnData::U32(Vec::new()),
                 F64 => ColumnData::F64(Vec::new()),
+                OptU32 => ColumnData::OptU32(Vec::new()),
             })
             .collect();
         Self { def, data, rows: 0 }
@@ -401,6 +411,7 @@ impl TableBuffer {
                 (ColumnData::U64(d), Cell::U64(v)) => d.push(*v),
                 (ColumnData::U32(d), Cell::U32(v)) => d.push(*v),
                 (ColumnData::F64(d), Cell::F64(v)) => d.push(*v),
+                (ColumnData::OptU32(d), Cell::OptU32(v)) => d.push(*v),
                 (d, v) => panic!(
                     "cell {v:?} does not fit column {d:?} of table {}",
                     self.def.name
@@ -422,16 +433,6 @@ pub struct Recording {
     pub pair_names: Vec<String>,
     /// Run metadata (key → value), written into the schema metadata.
     pub metadata: Vec<(String, String)>,
-}
-
-impl Recording {
-    /// Names for a dictionary.
-    pub fn dictionary(&self, d: Dictionary) -> &[String] {
-        match d {
-            Dictionary::Bodies => &self.body_names,
-            Dictionary::Pairs => &self.pair_names,
-        }
-    }
 }
 
 #[cfg(test)]
