@@ -22,6 +22,8 @@ import pytest
 
 import ballcage
 from ballcage import paper, studies
+from ballcage.paper import frames as paper_frames
+from ballcage.paper import motion as paper_motion
 
 REPO = Path(__file__).resolve().parent.parent
 #: The reference file of the project's shared folder (beside the repository in CI, or /work/shared).
@@ -57,6 +59,22 @@ def _reference_quantities(path: Path | None = None) -> list[dict]:
     else:
         text = path.read_text(encoding="utf-8")
     return tomllib.loads(text)["quantity"]
+
+
+#: Rows the comparison adds to the reference file's: (key, the key it follows, unit, paper value).
+EXTRA_ROWS = [
+    ("range_of_motion_peak_to_peak_mm", "range_of_motion_mm", "mm", 25.3),
+    ("head_cage_normal_peak_n", "seat_cage_normal_peak_n", "N", None),
+]
+
+
+def _expected_rows() -> list[tuple[str, float | None, str]]:
+    """(key, paper, unit) of every comparison row: the reference quantities, each extra row after its key."""
+    rows = []
+    for q in _reference_quantities():
+        rows.append((q["key"], float(q["value"]), q["unit"]))
+        rows.extend((key, paper, unit) for key, after, unit, paper in EXTRA_ROWS if after == q["key"])
+    return rows
 
 
 @pytest.fixture(scope="module")
@@ -103,10 +121,12 @@ def test_comparison_has_exactly_the_reference_keys_columns_and_types(paper_out):
         "note": pa.string(),
     }
     shipped = _reference_quantities()
-    assert table.column("key").to_pylist() == [q["key"] for q in shipped]
+    expected = _expected_rows()
+    assert len(expected) == len(shipped) + len(EXTRA_ROWS)
+    assert table.column("key").to_pylist() == [key for key, _, _ in expected]
     assert len(set(table.column("key").to_pylist())) == table.num_rows
-    assert table.column("paper").to_pylist() == [float(q["value"]) for q in shipped]
-    assert table.column("unit").to_pylist() == [q["unit"] for q in shipped]
+    assert table.column("paper").to_pylist() == [paper for _, paper, _ in expected]
+    assert table.column("unit").to_pylist() == [unit for _, _, unit in expected]
     for shared in SHARED_REFERENCES:
         if shared.exists():
             assert [q["key"] for q in _reference_quantities(shared)] == [q["key"] for q in shipped], shared
@@ -124,7 +144,7 @@ def test_comparison_notes_suspect_values_and_unrun_sweeps(paper_out):
             assert "not run: pass --sweeps" in row["note"], key
         else:
             assert row["ours"] is not None and math.isfinite(row["ours"]), key
-        if row["ours"] is not None and row["paper"] != 0:
+        if row["ours"] is not None and row["paper"] is not None and row["paper"] != 0:
             assert row["ratio"] == pytest.approx(row["ours"] / row["paper"]), key
         else:
             assert row["ratio"] is None, key
@@ -142,8 +162,12 @@ def test_comparison_markdown_has_title_command_and_one_row_per_key(paper_out):
     assert lines[0].startswith("# ")
     assert f"ballcage paper --out {out} --set simulation.duration=0.01" in text
     assert "| key | paper | ours | unit | ratio | note |" in lines
-    for q in _reference_quantities():
-        assert sum(line.startswith(f"| {q['key']} |") for line in lines) == 1, q["key"]
+    for key, _, _ in _expected_rows():
+        assert sum(line.startswith(f"| {key} |") for line in lines) == 1, key
+    # The paper gives no cage-head value: an empty paper cell and ratio, our value filled.
+    head = next(line for line in lines if line.startswith("| head_cage_normal_peak_n |")).split(" | ")
+    assert head[1] == "" and head[2] != "" and head[4] == "", head
+    assert "range_of_motion_peak_to_peak_mm" in text.split("| key |")[0]  # the paragraph names the extra rows
 
 
 def test_python_api_comparison_matches_the_cli(paper_out, short_run):
@@ -291,3 +315,156 @@ def test_run_paper_with_sweeps_fills_every_sweep_row(tmp_path):
     r1 = tomllib.loads((written["sweep_R1000"] / "scene.toml").read_text(encoding="utf-8"))
     assert r1["borehole"]["curvature_radius"] == 1.0
     assert "--sweeps" in written["comparison_md"].read_text(encoding="utf-8")
+
+
+# --------------------------------------------------------------------------- Table 3 as the paper defines it
+
+
+def _brute_peak_to_peak(x: np.ndarray, y: np.ndarray) -> float:
+    """Largest distance between any two points, by comparing every pair."""
+    d = np.hypot(x[:, None] - x[None, :], y[:, None] - y[None, :])
+    return float(d.max())
+
+
+@pytest.mark.parametrize(
+    ("links", "deformation", "link", "tied"),
+    [
+        ([4, 6, 5, 4], [0.023, 0.024, 0.025, 0.025], 4, (4,)),  # the paper's phases: 4, never round(4.75) = 5
+        ([2, 2, 9, 9], [0.010, 0.011, 0.012, 0.009], 9, (2, 9)),  # tie: 9 reaches the largest offset
+        ([11, 2, 2, 3], [0.015, 0.014, 0.0149, 0.015], 2, (2,)),  # mean 4.5 would name a link no phase has
+        ([7], [0.001], 7, (7,)),
+        ([3, 8], [0.012, 0.012], 3, (3, 8)),  # equal offsets too: the lower link number
+    ],
+)
+def test_most_frequent_link_of_the_phases(links, deformation, link, tied):
+    chosen = paper_motion.most_frequent(links, deformation)
+    assert chosen.link == link
+    assert chosen.tied == tied
+    assert chosen.tie == (len(tied) > 1)
+    assert chosen.count == links.count(link)
+
+
+def test_most_frequent_refuses_mismatched_or_empty_phases():
+    with pytest.raises(ValueError):
+        paper_motion.most_frequent([], [])
+    with pytest.raises(ValueError):
+        paper_motion.most_frequent([1, 2], [0.1])
+
+
+def test_peak_to_peak_of_a_circle_is_its_diameter_and_the_offset_its_radius():
+    # A centre going once round a circle of radius 10 mm: 20 mm peak to peak, 10 mm largest offset.
+    theta = np.linspace(0.0, 2.0 * math.pi, 601)
+    x, y = 0.010 * np.cos(theta), 0.010 * np.sin(theta)
+    assert paper_motion.peak_to_peak(x, y) == pytest.approx(0.020, rel=1e-12)
+    assert paper_motion.largest_offset(x, y) == pytest.approx(0.010, rel=1e-12)
+    # Off-centre: a circle of radius 5 mm about (8, 0) mm has 10 mm excursion but a 13 mm largest offset.
+    assert paper_motion.peak_to_peak(0.008 + x / 2, y / 2) == pytest.approx(0.010, rel=1e-12)
+    assert paper_motion.largest_offset(0.008 + x / 2, y / 2) == pytest.approx(0.013, rel=1e-12)
+
+
+def test_peak_to_peak_matches_every_pair_on_random_paths():
+    rng = np.random.default_rng(7)
+    for n in (1, 2, 3, 17, 400):
+        x, y = rng.normal(0.0, 0.005, n), rng.normal(0.0, 0.002, n)
+        assert paper_motion.peak_to_peak(x, y) == pytest.approx(_brute_peak_to_peak(x, y), rel=1e-12), n
+    # Collinear points, repeats and NaN (a frame without the link) are handled.
+    x = np.array([0.0, 0.001, 0.003, 0.003, np.nan, -0.002])
+    assert paper_motion.peak_to_peak(x, 2.0 * x) == pytest.approx(0.005 * math.sqrt(5.0), rel=1e-12)
+    assert math.isnan(paper_motion.peak_to_peak(np.array([np.nan]), np.array([0.0])))
+
+
+def _synthetic_run(duration: float = 0.6, interval: float = 0.05) -> ballcage.Run:
+    """A links table built by hand on the paper scene's TOML (100 rpm: phases at 0.15, 0.3, 0.45, 0.6 s).
+
+    Link 4 circles the centreline at 10 mm once over the run; link 6 sits 12 mm out at the 90° phase and link 5
+    11 mm out at the 180° phase; every other centre stays 1 mm out. The most deformed links of the phases are
+    therefore 4, 6, 5, 4. Link k's included angle is 180 - k - frame / 100 deg.
+    """
+    scene = paper.paper_scene([f"simulation.duration={duration}", f"simulation.output_interval={interval}"])
+    times = np.round(np.arange(0.0, duration + interval / 2, interval), 12)
+    cols: dict[str, list] = {c: [] for c in ("t", "link", "offset_outward", "offset_lateral", "included_angle_deg")}
+    for f, t in enumerate(times):
+        for k in range(1, 13):
+            out, lat = 0.001, 0.0
+            if k == 4:
+                theta = 2.0 * math.pi * t / duration
+                out, lat = 0.010 * math.cos(theta), 0.010 * math.sin(theta)
+            elif k == 6 and f == 6:
+                out = 0.012
+            elif k == 5 and f == 9:
+                out = 0.011
+            for name, v in (("t", t), ("link", k), ("offset_outward", out), ("offset_lateral", lat)):
+                cols[name].append(v)
+            cols["included_angle_deg"].append(180.0 - k - f / 100.0)
+    table = pa.table(cols)
+    table = table.append_column("radial_offset", pa.array(np.hypot(cols["offset_outward"], cols["offset_lateral"])))
+    zeros = pa.array(np.zeros(table.num_rows))
+    table = table.append_column("tube_normal", zeros).append_column("tube_tangential", zeros)
+    return ballcage.Run({"links": table}, scene.to_toml())
+
+
+def test_table3_rows_on_a_hand_built_run():
+    rows = {r["key"]: r for r in paper.comparison(_synthetic_run()).to_pylist()}
+    # Phases 4, 6, 5, 4: the most frequent is 4 (a rounded mean would say 5).
+    assert rows["most_deformed_joint"]["ours"] == 4.0
+    assert "per-phase most deformed links 4, 6, 5, 4: link 4 at 2 of 4 phases" in rows["most_deformed_joint"]["note"]
+    assert "tie" not in rows["most_deformed_joint"]["note"].split("per-phase")[1]
+    # Included angle at hinge k between link k and link k+1, k = 4, 6, 5, 4 at frames 3, 6, 9, 12.
+    angles = [180.0 - k - f / 100.0 for k, f in ((4, 3), (6, 6), (5, 9), (4, 12))]
+    assert rows["included_angle_min_deg"]["ours"] == pytest.approx(min(angles))
+    assert rows["included_angle_max_deg"]["ours"] == pytest.approx(max(angles))
+    assert "hinge k between link k and link k+1" in rows["included_angle_min_deg"]["note"]
+    assert "hinges 4, 6, 5, 4 at the phases" in rows["included_angle_min_deg"]["note"]
+    # The two ranges of motion: the largest centre offset at the phases (link 6's 12 mm) and link 4's excursion
+    # over the last revolution (0-0.6 s, the whole circle: 20 mm).
+    assert rows["range_of_motion_mm"]["ours"] == pytest.approx(12.0)
+    p2p = rows["range_of_motion_peak_to_peak_mm"]
+    assert p2p["ours"] == pytest.approx(20.0)
+    assert p2p["paper"] == 25.3 and p2p["ratio"] == pytest.approx(20.0 / 25.3)
+    assert "excursion 20.00 mm, largest centre offset 10.00 mm" in p2p["note"]
+    assert "radial clearance 15.0 mm" in rows["range_of_motion_mm"]["note"]
+    assert "can only be an excursion" in rows["range_of_motion_mm"]["note"]
+    # No hinges table: both cage rows say why.
+    for key in ("seat_cage_normal_peak_n", "head_cage_normal_peak_n"):
+        assert rows[key]["ours"] is None and "hinges table" in rows[key]["note"], key
+
+
+def test_table3_tie_goes_to_the_largest_offset():
+    # Only the last two phases (0.45 and 0.6 s) lie in a 0.6 s run started 0.3 s late: links 5 and 4, one each.
+    run = _synthetic_run()
+    links = run.tables["links"]
+    late = links.filter(pc.greater_equal(links.column("t"), 0.3 + 1e-9))
+    run = ballcage.Run({"links": late}, run.scene_toml)
+    row = {r["key"]: r for r in paper.comparison(run).to_pylist()}["most_deformed_joint"]
+    assert row["ours"] == 5.0  # 11 mm at 180° beats link 4's 10 mm at 270°
+    assert "tie between links 4, 5 (1 each): link 5 has the largest offset (11.00 mm)" in row["note"]
+
+
+def test_included_angle_at_hinge_k_is_180_minus_the_bend_of_hinge_k(short_run):
+    # links.included_angle_deg of link k is the angle between link k and body k+1: hinge k's (link 12: the lower
+    # connector, hinge 12). The Fig. 9 and Table 3 rows rely on it.
+    links, hinges = short_run.tables["links"], short_run.tables["hinges"]
+    times = np.unique(links.column("t").to_numpy())
+    angle = paper_frames.frame_grid(links, times, ["link"], ["included_angle_deg"])["included_angle_deg"][:, 1:]
+    bend = paper_frames.frame_grid(hinges, times, ["hinge"], ["bend_deg"])["bend_deg"]
+    assert angle.shape[1] == 12 and bend.shape[1] == 13
+    assert angle == pytest.approx(180.0 - bend[:, 1:], abs=1e-9)
+
+
+def test_new_rows_on_a_short_run(short_run):
+    rows = {r["key"]: r for r in paper.comparison(short_run).to_pylist()}
+    hinges = short_run.tables["hinges"]
+    head = rows["head_cage_normal_peak_n"]
+    assert head["ours"] == pytest.approx(float(hinges.column("cage_head_normal").to_numpy().max()))
+    assert head["paper"] is None and head["ratio"] is None
+    assert "the paper reports no value" in head["note"]
+    assert "head_cage_normal_peak_n" in rows["seat_cage_normal_peak_n"]["note"]
+    # The excursion of the most deformed link over the (partly recorded) last revolution, by every pair.
+    link = int(rows["most_deformed_joint"]["ours"])
+    links = short_run.tables["links"]
+    mine = links.filter(pc.equal(links.column("link"), link))
+    x, y = mine.column("offset_outward").to_numpy(), mine.column("offset_lateral").to_numpy()
+    p2p = rows["range_of_motion_peak_to_peak_mm"]
+    assert p2p["ours"] == pytest.approx(1e3 * _brute_peak_to_peak(x, y), rel=1e-9)
+    assert "the run holds only 0.010 s of it" in p2p["note"]
+    assert rows["range_of_motion_mm"]["ours"] <= 1e3 * MAX_RADIAL_OFFSET

@@ -10,7 +10,10 @@ every table recorded, and writes into one directory:
 - ``comparison.parquet`` and ``comparison.md``: one row per ``[[quantity]]``
   of the shipped reference file ``ballcage/data/paper-2023.toml``, with the
   paper's value, ours, their ratio and a note on how our definition differs
-  and on values the paper itself contradicts (``suspect``).
+  and on values the paper itself contradicts (``suspect``); plus the rows of
+  `EXTRA_ROWS` the file lacks (``range_of_motion_peak_to_peak_mm``, the
+  definition of Table 3's range of motion that fits the paper, and
+  ``head_cage_normal_peak_n``, which the paper does not report).
 
 With ``sweeps=True`` it also runs the curvature (R = 1.0, 2.5 m) and speed
 (60, 120 rpm) variants of §4.2–4.3 and fills the ``sweep_*`` rows.
@@ -23,12 +26,14 @@ row's note.
 
 Modules, one job each: `running` (the scenes and `run_paper`), `definitions`
 (the reference file and how each quantity is computed), `facts` (scene values
-and Table 3's phases), `frames` (per-frame grids of the tables), `compare` (the
-comparison table), `markdown` (``comparison.md``), `figures` (the PNGs).
+and Table 3's phases), `motion` (Table 3's most deformed joint and range of
+motion: most frequent link, peak-to-peak excursion), `frames` (per-frame grids
+of the tables), `compare` (the comparison table), `markdown`
+(``comparison.md``), `figures` (the PNGs).
 """
 
 from ballcage.paper.compare import COMPARISON_SCHEMA, comparison
-from ballcage.paper.definitions import SWEEPS, TUBE_LINKS, reference
+from ballcage.paper.definitions import EXTRA_ROWS, SWEEPS, TUBE_LINKS, reference
 from ballcage.paper.facts import PHASES
 from ballcage.paper.figures import FIGURES, KEY_BODIES, write_figures
 from ballcage.paper.markdown import comparison_markdown
@@ -36,6 +41,7 @@ from ballcage.paper.running import PAPER_TABLES, SWEEP_TABLES, paper_scene, run_
 
 __all__ = [
     "COMPARISON_SCHEMA",
+    "EXTRA_ROWS",
     "FIGURES",
     "KEY_BODIES",
     "PAPER_TABLES",

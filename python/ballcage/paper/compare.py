@@ -15,6 +15,7 @@ from ballcage import _native
 from ballcage._links import link_tube_forces
 from ballcage.paper.definitions import (
     DEFINITIONS,
+    EXTRA_ROWS,
     NOT_SWEPT,
     REFERENCE_FILE,
     SUSPECT_FALLBACK,
@@ -24,8 +25,9 @@ from ballcage.paper.definitions import (
     TUBE_LINKS,
     reference,
 )
-from ballcage.paper.facts import SceneFacts, phases, scene_facts
+from ballcage.paper.facts import Phase, SceneFacts, phases, scene_facts
 from ballcage.paper.frames import argmax_where, frame_grid, frame_times
+from ballcage.paper.motion import MostFrequent, centre_paths, last_revolution, most_frequent
 from ballcage.run import Run
 
 __all__ = ["COMPARISON_SCHEMA", "comparison", "fmt"]
@@ -56,15 +58,18 @@ def comparison(run: Run, sweep_runs: Mapping[str, Run] | None = None) -> pa.Tabl
     """The comparison with the paper: one row per ``[[quantity]]`` of the reference file.
 
     Columns ``key, paper, ours, unit, ratio, note`` (`COMPARISON_SCHEMA`);
-    ``ours`` and ``ratio`` are null where a value is not computed. `run` is a
+    ``ours`` and ``ratio`` are null where a value is not computed, ``paper``
+    and ``ratio`` where the paper gives no value. The rows of `EXTRA_ROWS`
+    (a second definition, a value the paper lacks) follow the reference
+    quantity they belong to. `run` is a
     run of the paper scene that recorded `PAPER_TABLES`; `sweep_runs` maps the
     `SWEEPS` ids (``"R1000"``, …) to runs of the variants.
     """
     facts = scene_facts(run)
     values = _baseline_values(run, facts)
     columns: dict[str, list[Any]] = {f.name: [] for f in COMPARISON_SCHEMA}
-    for q in reference().get("quantity", []):
-        for name, cell in _row(q, _value(q["key"], values, sweep_runs)).items():
+    for spec in row_specs(reference().get("quantity", [])):
+        for name, cell in _row(spec, _value(spec.key, values, sweep_runs)).items():
             columns[name].append(cell)
     meta = {
         "ballcage.reference": REFERENCE_FILE,
@@ -87,23 +92,46 @@ def _value(key: str, values: Mapping[str, _Value], sweep_runs: Mapping[str, Run]
     return _sweep_value(sweep_runs[variant], variant, m.group("what"))
 
 
-def _row(q: Mapping[str, Any], value: _Value) -> dict[str, Any]:
-    """One comparison row from a reference ``[[quantity]]`` `q` and our `value`."""
-    key = q["key"]
-    paper = float(q["value"])
+@dataclass(frozen=True)
+class RowSpec:
+    """One row of the comparison: its key, the paper's value (None: the paper gives none), unit, suspect flag."""
+
+    key: str
+    paper: float | None
+    unit: str
+    suspect: bool = False
+
+
+def row_specs(quantities: list[Mapping[str, Any]]) -> list[RowSpec]:
+    """The comparison's rows: each reference ``[[quantity]]``, each `EXTRA_ROWS` row right after its `after` key."""
+    by_key = {q["key"]: q for q in quantities}
+    specs = []
+    for q in quantities:
+        specs.append(RowSpec(q["key"], float(q["value"]), str(q.get("unit", "")), bool(q.get("suspect", False))))
+        for extra in (e for e in EXTRA_ROWS if e.after == q["key"]):
+            source = by_key.get(extra.paper_from) if extra.paper_from is not None else None
+            paper = float(source["value"]) if source is not None else None
+            suspect = bool(source is not None and source.get("suspect", False))
+            specs.append(RowSpec(extra.key, paper, extra.unit, suspect))
+    return specs
+
+
+def _row(spec: RowSpec, value: _Value) -> dict[str, Any]:
+    """One comparison row from its `spec` and our `value`."""
     notes = []
-    if q.get("suspect", False):
-        notes.append(SUSPECT_REASONS.get(key, SUSPECT_FALLBACK))
+    if spec.suspect:
+        notes.append(SUSPECT_REASONS.get(spec.key, SUSPECT_FALLBACK))
     if value.note:
         notes.append(value.note)
     ours = value.ours if value.ours is not None and math.isfinite(value.ours) else None
     ratio = None
-    if ours is not None:
-        if paper != 0.0:
-            ratio = ours / paper
+    if ours is not None and spec.paper is not None:
+        if spec.paper != 0.0:
+            ratio = ours / spec.paper
         else:
             notes.append("paper value is 0: ratio undefined")
-    return {"key": key, "paper": paper, "ours": ours, "unit": str(q.get("unit", "")), "ratio": ratio, "note": "; ".join(notes)}
+    note = "; ".join(notes)
+    return {"key": spec.key, "paper": spec.paper, "ours": ours, "unit": spec.unit, "ratio": ratio, "note": note}
 
 
 def fmt(x: float, digits: int = 4) -> str:
@@ -119,30 +147,87 @@ def _baseline_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
     return values
 
 
+_PHASE_KEYS = (
+    "included_angle_min_deg",
+    "included_angle_max_deg",
+    "range_of_motion_mm",
+    "range_of_motion_peak_to_peak_mm",
+    "most_deformed_joint",
+)
+
+
 def _phase_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
-    keys = ("included_angle_min_deg", "included_angle_max_deg", "range_of_motion_mm", "most_deformed_joint")
+    """Table 3's rows: included angles, the two ranges of motion and the most deformed joint."""
     if "links" not in run.tables:
-        return {k: _Value(None, "not computed: the run did not record the links table") for k in keys}
+        return {k: _Value(None, "not computed: the run did not record the links table") for k in _PHASE_KEYS}
     found, skipped = phases(run, facts)
     if not found:
-        return {k: _Value(None, "not computed: none of the four phases lies in the run") for k in keys}
+        return {k: _Value(None, "not computed: none of the four phases lies in the run") for k in _PHASE_KEYS}
     listing = ", ".join(
-        f"{p.label} t={p.t:.3f} s: link {p.most_deformed}, {p.included_angle:.2f} deg, {p.offset_mm:.2f} mm"
+        f"{p.label} t={p.t:.3f} s: link {p.most_deformed}, {p.included_angle:.2f} deg at hinge {p.most_deformed}, "
+        f"{p.offset_mm:.2f} mm"
         for p in found
     )
     where = f"phases ({listing})"
     if skipped:
         where += f"; {len(found)} of 4 phases in the run ({', '.join(skipped)} fall before t = 0)"
+    chosen = most_frequent([p.most_deformed for p in found], [p.offset_mm for p in found])
     angles = [p.included_angle for p in found]
+    hinges = ", ".join(str(p.most_deformed) for p in found)
+    angle_where = f"hinges {hinges} at the phases; {where}"
+    if any(p.most_deformed == 12 for p in found):
+        angle_where = f"hinge 12's next body is the lower connector, not a link; {angle_where}"
+    clearance = (
+        f"radial clearance {1e3 * facts.clearance:.1f} mm = (tube bore {2e3 * facts.tube_inner_radius:.0f} mm - "
+        f"link diameter {2e3 * facts.link_radius:.0f} mm) / 2"
+    )
     return {
-        "included_angle_min_deg": _Value(min(angles), f"{DEFINITIONS['included_angle_min_deg']}; {where}"),
-        "included_angle_max_deg": _Value(max(angles), f"{DEFINITIONS['included_angle_max_deg']}; {where}"),
-        "range_of_motion_mm": _Value(max(p.offset_mm for p in found), f"{DEFINITIONS['range_of_motion_mm']}; {where}"),
+        "included_angle_min_deg": _Value(min(angles), f"{DEFINITIONS['included_angle_min_deg']}; {angle_where}"),
+        "included_angle_max_deg": _Value(max(angles), f"{DEFINITIONS['included_angle_max_deg']}; {angle_where}"),
+        "range_of_motion_mm": _Value(
+            max(p.offset_mm for p in found), f"{DEFINITIONS['range_of_motion_mm']}; {clearance}; {where}"
+        ),
+        "range_of_motion_peak_to_peak_mm": _excursion_value(run, facts, chosen, found, clearance),
         "most_deformed_joint": _Value(
-            float(round(sum(p.most_deformed for p in found) / len(found))),
-            f"{DEFINITIONS['most_deformed_joint']}; {where}",
+            float(chosen.link), f"{DEFINITIONS['most_deformed_joint']}; {_choice_note(chosen, found)}; {where}"
         ),
     }
+
+
+def _choice_note(chosen: MostFrequent, found: list[Phase]) -> str:
+    """How the most frequent link was chosen from the phases' links."""
+    links = ", ".join(str(p.most_deformed) for p in found)
+    text = f"per-phase most deformed links {links}: link {chosen.link} at {chosen.count} of {len(found)} phases"
+    if chosen.tie:
+        largest = max(p.offset_mm for p in found if p.most_deformed == chosen.link)
+        tied = ", ".join(map(str, chosen.tied))
+        text += (
+            f"; tie between links {tied} ({chosen.count} each): link {chosen.link} has the largest offset "
+            f"({largest:.2f} mm)"
+        )
+    return text
+
+
+def _excursion_value(run: Run, facts: SceneFacts, chosen: MostFrequent, found: list[Phase], clearance: str) -> _Value:
+    """Peak-to-peak excursion of the most deformed link's centre over the last revolution [mm]."""
+    start, end = last_revolution(facts)
+    paths = centre_paths(run, start, end)
+    if paths is None:
+        return _Value(None, "not computed: no frame of the links table in the last revolution")
+    covered = f"last revolution {start:.3f}-{end:.3f} s, {paths.frames} frames"
+    if paths.start > start + 0.5 * facts.output_interval + 1e-9:
+        covered += f" (the run holds only {paths.end - paths.start:.3f} s of it)"
+    k = chosen.link
+    value = 1e3 * paths.peak_to_peak(k)
+    phase_links = sorted({p.most_deformed for p in found})
+    others = ", ".join(f"link {j}: {1e3 * paths.peak_to_peak(j):.2f} mm" for j in phase_links)
+    widest = max(paths.links, key=lambda j: np.nan_to_num(paths.peak_to_peak(j), nan=-1.0))
+    return _Value(
+        value,
+        f"{DEFINITIONS['range_of_motion_peak_to_peak_mm']}; link {k} over the {covered}: excursion {value:.2f} mm, "
+        f"largest centre offset {1e3 * paths.largest_offset(k):.2f} mm ({clearance}); excursions of the phases' "
+        f"links: {others}; largest of any link: link {widest} ({1e3 * paths.peak_to_peak(widest):.2f} mm)",
+    )
 
 
 def _tube_values(run: Run) -> dict[str, _Value]:
@@ -191,14 +276,7 @@ def _tube_values(run: Run) -> dict[str, _Value]:
 def _internal_values(run: Run) -> dict[str, _Value]:
     out: dict[str, _Value] = {}
     times = frame_times(run)
-    hinges = run.tables.get("hinges")
-    if hinges is None:
-        out["seat_cage_normal_peak_n"] = _Value(None, "not computed: the run did not record the hinges table")
-    else:
-        grid = frame_grid(hinges, times, ["hinge"], ["cage_seat_normal"])["cage_seat_normal"]
-        v, ids, t = argmax_where(grid, times)
-        where = f"; at hinge {ids[0]:02d}, t = {t:.4g} s" if ids else ""
-        out["seat_cage_normal_peak_n"] = _Value(v, f"{DEFINITIONS['seat_cage_normal_peak_n']}{where}")
+    out.update(_cage_values(run, times))
     keys = run.tables.get("keys")
     specs = {
         "cage_key_normal_peak_n": "window_normal",
@@ -214,6 +292,26 @@ def _internal_values(run: Run) -> dict[str, _Value]:
         v, ids, t = argmax_where(grids[column], times)
         where = f"; at hinge {ids[0]:02d} key {ids[1]}, t = {t:.4g} s" if ids else ""
         out[key] = _Value(v, f"{DEFINITIONS[key]}{where}")
+    return out
+
+
+def _cage_values(run: Run, times: np.ndarray) -> dict[str, _Value]:
+    """Peak cage-seat and cage-head normal forces over hinges and frames [N]."""
+    specs = {"seat_cage_normal_peak_n": "cage_seat_normal", "head_cage_normal_peak_n": "cage_head_normal"}
+    hinges = run.tables.get("hinges")
+    if hinges is None:
+        return {k: _Value(None, "not computed: the run did not record the hinges table") for k in specs}
+    if run.scene.value("pipe.hinge") != "ball-keys":
+        why = f"not computed: pipe.hinge = {run.scene.value('pipe.hinge')!r} has no cages"
+        return {k: _Value(None, why) for k in specs}
+    grids = frame_grid(hinges, times, ["hinge"], list(specs.values()))
+    peaks = {key: argmax_where(grids[column], times) for key, column in specs.items()}
+    out = {}
+    for key, (v, ids, t) in peaks.items():
+        where = f"; at hinge {ids[0]:02d}, t = {t:.4g} s" if ids else ""
+        other = "head_cage_normal_peak_n" if key == "seat_cage_normal_peak_n" else "seat_cage_normal_peak_n"
+        side = "head" if other.startswith("head") else "seat"
+        out[key] = _Value(v, f"{DEFINITIONS[key]}{where}; the cage-{side} peak is {fmt(peaks[other][0])} N ({other})")
     return out
 
 

@@ -54,35 +54,49 @@ def write_figures(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
 
 
 def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
+    """Fig. 9: the included angle at hinge k between link k and link k+1 (links.included_angle_deg of link k).
+
+    Hinges 1-11 join two links (the paper's adjacent joints); hinge 12 joins
+    link 12 and the lower connector and is drawn apart (hollow markers, dashed).
+    """
     fig = figure(figsize=(11, 4.5))
-    by_link, over_time = fig.subplots(1, 2)
+    by_hinge, over_time = fig.subplots(1, 2)
     links = run.tables.get("links")
     found, skipped = phases(run, facts)
     if links is not None and links.num_rows:
         grid = frame_grid(links, times, ["link"], ["included_angle_deg"])["included_angle_deg"][:, 1:]
-        numbers = np.arange(1, grid.shape[1] + 1)
+        hinges = np.arange(1, grid.shape[1] + 1)
+        inner = hinges[:-1]  # between two links
         for p in found:
-            by_link.plot(numbers, grid[p.frame], marker="o", label=f"{p.label} (t = {p.t:.3f} s)")
-        by_link.set_xticks(numbers)
+            (line,) = by_hinge.plot(inner, grid[p.frame, :-1], marker="o", label=f"{p.label} (t = {p.t:.3f} s)")
+            by_hinge.plot(hinges[-1:], grid[p.frame, -1:], marker="o", mfc="none", ls="none", color=line.get_color())
+        by_hinge.set_xticks(hinges)
         cmap = colormap("viridis")
         for k in range(grid.shape[1]):
-            over_time.plot(times, grid[:, k], color=cmap(k / max(grid.shape[1] - 1, 1)), lw=1, label=f"link {k + 1}")
+            last = k == grid.shape[1] - 1
+            label = f"hinge {k + 1}" + (" (lower conn.)" if last else "")
+            color = cmap(k / max(grid.shape[1] - 1, 1))
+            over_time.plot(times, grid[:, k], color=color, lw=1, ls="--" if last else "-", label=label)
         over_time.legend(fontsize=7, ncol=2, loc="best")
     else:
         no_data(over_time, "no links table")
     if found:
-        by_link.legend(fontsize=8, title="phase of the upper connector", title_fontsize=8)
+        by_hinge.legend(fontsize=8, title="phase of the upper connector", title_fontsize=8)
     if skipped:
-        by_link.text(
-            0.01, 0.01, f"phases before t = 0 not shown: {', '.join(skipped)}", transform=by_link.transAxes, fontsize=7
+        by_hinge.text(
+            0.01, 0.01, f"phases before t = 0 not shown: {', '.join(skipped)}", transform=by_hinge.transAxes, fontsize=7
         )
-    by_link.set(
-        xlabel="link number k [-]",
-        ylabel="included angle, link k / body k+1 [deg]",
+    by_hinge.set(
+        xlabel="hinge k [-] (1-11: link k / link k+1; hollow 12: link 12 / lower connector)",
+        ylabel="included angle at hinge k [deg]",
         title="At the four phases of the last revolution",
     )
-    over_time.set(xlabel="time [s]", ylabel="included angle, link k / body k+1 [deg]", title="Over time")
-    fig.suptitle("Fig. 9: angle between adjacent links (180 deg = straight)")
+    over_time.set(xlabel="time [s]", ylabel="included angle at hinge k [deg]", title="Over time")
+    fig.suptitle(
+        "Fig. 9: included angle at hinge k between link k and link k+1 "
+        "(links.included_angle_deg of link k = 180 - hinges.bend_deg; 180 deg = straight)",
+        fontsize=10,
+    )
     return fig
 
 

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 import pyarrow as pa
 
 from ballcage.paper.compare import fmt
-from ballcage.paper.definitions import REFERENCE_FILE, SWEEPS
+from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS
 from ballcage.paper.facts import scene_facts
 from ballcage.run import Run
 
@@ -40,7 +40,8 @@ def comparison_markdown(
         (
             f"{duration}Each row is one `[[quantity]]` of the shipped reference file "
             f"(`ballcage/data/{REFERENCE_FILE}`): the paper's value, ours from the recorded tables, and "
-            "ratio = ours / paper. The note says how our definition is computed, where it differs from the "
+            f"ratio = ours / paper. {_extra_rows_sentence()} "
+            "The note says how our definition is computed, where it differs from the "
             "paper's, and when the paper's own value is suspect (it contradicts other numbers of the paper, "
             "see docs/model.md §6): compare those as order of magnitude only. Empty cells were not computed. "
             + (f"Sweep variants run: {swept}." if swept else "Sweep rows need `--sweeps`.")
@@ -50,8 +51,22 @@ def comparison_markdown(
         "| --- | ---: | ---: | --- | ---: | --- |",
     ]
     for r in table.to_pylist():
+        paper = "" if r["paper"] is None else fmt(r["paper"])
         ours = "" if r["ours"] is None else fmt(r["ours"])
         ratio = "" if r["ratio"] is None else f"{r['ratio']:.3f}"
         note = str(r["note"]).replace("|", "\\|")
-        lines.append(f"| {r['key']} | {fmt(r['paper'])} | {ours} | {r['unit']} | {ratio} | {note} |")
+        lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
     return "\n".join(lines) + "\n"
+
+
+def _extra_rows_sentence() -> str:
+    """Which rows are not in the reference file and where their paper value comes from."""
+    parts = [
+        f"`{e.key}` (paper value: that of `{e.paper_from}`)" if e.paper_from else f"`{e.key}` (the paper gives none)"
+        for e in EXTRA_ROWS
+    ]
+    return (
+        f"Rows the reference file lacks follow the row they belong to: {', '.join(parts)}; "
+        "the per-phase rows of Table 3 (most deformed link, included angle at hinge k between link k and link k+1) "
+        "list each phase in the note."
+    )

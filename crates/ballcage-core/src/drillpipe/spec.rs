@@ -163,7 +163,10 @@ pub struct PipeSpec {
     pub connector_mass: f64,
     /// Connector principal inertia, axial then transverse [kg·m²].
     pub connector_inertia: [f64; 3],
-    /// Sample points along each link for link–tube contact. PROPOSAL: 5.
+    /// Sample points along each link (rims included) that locate its
+    /// contact patches with the tube; each patch carries one force, from its
+    /// largest penetration, so the force does not depend on this count.
+    /// PROPOSAL: 5.
     pub tube_contact_points: u32,
     /// Ball-cage joint details (used by `hinge = "ball-keys"`).
     pub ball_keys: BallKeySpec,

@@ -13,9 +13,10 @@
 //! |---|---|
 //! | half-space–ball, ball–ball, ball–cuboid | parry3d `query::contact` (exact for these convex pairs) |
 //! | cuboid–half-space | analytic: each vertex below the plane is a point |
-//! | cylinder–tube | analytic: `points` samples along the axis, the surface point farthest from the centreline |
+//! | cylinder–tube | analytic line contact (`line.rs`): one point per contact patch at its deepest penetration; `points` samples along the axis locate the patches |
 //! | ball–tube | analytic: distance to the centreline |
 
+mod line;
 mod tube;
 
 pub use tube::{CentrelinePoint, TubePath, TubeSegment};
@@ -96,9 +97,9 @@ pub enum PairGeometry {
     ParryConvex,
     /// Cuboid vertices against a half-space, up to 8 points.
     CuboidHalfSpace,
-    /// Cylinder inside a tube, `points` samples.
+    /// Cylinder inside a tube: one point per contact patch, at its deepest.
     CylinderTube {
-        /// Samples along the axis.
+        /// Samples along the axis (rims included) that locate the patches.
         points: u32,
     },
     /// Ball inside a tube.
@@ -223,7 +224,7 @@ impl PairGeometry {
                     radius,
                     half_length,
                 },
-            ) => cylinder_tube(t, p1, *radius, *half_length, points, p2, out),
+            ) => line::cylinder_tube(t, p1, *radius, *half_length, points, p2, out),
             (Self::BallTube, Shape::Tube(t), Shape::Ball(b)) => ball_tube(t, p1, b.radius, p2, out),
             (
                 Self::TorusBall {
@@ -347,42 +348,6 @@ fn wall_contact(t: &TubePath, w: &Vec3) -> Option<(Vec3, Vec3, f64)> {
     }
     let out = r / d;
     Some((w - 0.5 * depth * out, -out, depth))
-}
-
-fn cylinder_tube(
-    t: &TubePath,
-    pt: (&Vec3, &Quat),
-    radius: f64,
-    half_length: f64,
-    points: u32,
-    pc: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
-) {
-    // Work in the tube frame.
-    let inv = pt.1.inverse();
-    let centre = inv * (pc.0 - pt.0);
-    let axis = inv * (pc.1 * Vec3::x());
-    let n = points.max(2);
-    for k in 0..n {
-        let s = -half_length + 2.0 * half_length * f64::from(k) / f64::from(n - 1);
-        let q = centre + s * axis;
-        let Some(c) = t.nearest(&q) else { continue };
-        let r = q - c.point;
-        let across = r - r.dot(&axis) * axis;
-        let len = across.norm();
-        if len < 1e-15 {
-            continue;
-        }
-        let w = q + radius * across / len;
-        if let Some((p, nrm, depth)) = wall_contact(t, &w) {
-            out.push(ContactPoint {
-                slot: k,
-                point: pt.0 + pt.1 * p,
-                normal: pt.1 * nrm,
-                depth,
-            });
-        }
-    }
 }
 
 fn ball_tube(
@@ -664,34 +629,5 @@ mod tests {
         assert_eq!(out.len(), 1);
         assert_relative_eq!(out[0].depth, 1e-4, epsilon = 1e-12);
         assert_relative_eq!(out[0].normal, -Vec3::y(), epsilon = 1e-12);
-    }
-
-    #[test]
-    fn cylinder_lying_in_a_straight_tube_touches_along_its_bottom_line() {
-        let tube = Shape::Tube(TubePath::new(
-            0.058,
-            Vec3::new(-1.0, 0.0, 0.0),
-            Vec3::x(),
-            &[TubeSegment::Straight { length: 2.0 }],
-        ));
-        let cyl = Shape::Cylinder {
-            radius: 0.043,
-            half_length: 0.1,
-        };
-        let pt = pose([0.0; 3]);
-        let pc = pose([0.0, 0.0, -0.0151]);
-        let mut out = vec![];
-        PairGeometry::CylinderTube { points: 5 }.contacts(
-            &tube,
-            (&pt.0, &pt.1),
-            &cyl,
-            (&pc.0, &pc.1),
-            &mut out,
-        );
-        assert_eq!(out.len(), 5);
-        for p in &out {
-            assert_relative_eq!(p.depth, 1e-4, epsilon = 1e-12);
-            assert_relative_eq!(p.normal, Vec3::z(), epsilon = 1e-12);
-        }
     }
 }

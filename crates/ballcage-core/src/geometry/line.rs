@@ -1,0 +1,347 @@
+//! A cylinder (a drill-pipe link) inside a tube: a line contact reduced to
+//! one point per contact patch.
+//!
+//! MSC Adams, and so the paper, applies its IMPACT law once per contact
+//! patch, with the patch's largest penetration. ballcage does the same: the
+//! force a link gets does not depend on how finely it is sampled. A link
+//! pressed uniformly into the wall at depth δ gets the single-point law at δ
+//! for any sample count, and a link touching at one rim gets the
+//! single-point law at that rim (docs/model.md §7.6). The force acts at the
+//! patch's centre of pressure, the depth-weighted centroid of its sampled
+//! surface points (PROPOSAL: a link lying along the wall then feels no
+//! torque from where round-off puts its deepest sample, and a tilting link
+//! feels its centre of pressure move continuously toward the deeper end).
+//!
+//! At axial position s the link's surface point deepest in the wall is the
+//! rim point farthest from the centreline, so the depth profile is
+//! d(s) = |u(s)| + r − R_tube, u the axis point's offset from the centreline.
+//! Its maxima are the rims and the interior points where |u| stops growing:
+//! since u is perpendicular to the centreline at the nearest point,
+//! d|u|²/ds = 2 u·â exactly (â the link axis), so a maximum lies between two
+//! samples where u·â changes from positive to negative. There a
+//! golden-section search finds it to round-off, so the largest penetration
+//! of a patch is exact, and a patch lying wholly between two samples (a
+//! straight link against the convex inner wall of a bend) is not missed.
+//! The `points` samples along the axis (rims included) locate the patches: a
+//! patch is a run of samples in contact, or such a hidden maximum.
+
+use super::{ContactPoint, TubePath};
+use crate::math::{Quat, Vec3};
+
+/// A cylinder's surface in a tube, in the tube's frame.
+struct LinkInTube<'a> {
+    tube: &'a TubePath,
+    /// Centre of the cylinder [m].
+    centre: Vec3,
+    /// Unit axis.
+    axis: Vec3,
+    /// Cylinder radius [m].
+    radius: f64,
+}
+
+/// The deepest surface point of one axial station.
+struct Station {
+    /// Midpoint between the surfaces [m], tube frame.
+    point: Vec3,
+    /// Unit normal from the tube toward the link, tube frame.
+    normal: Vec3,
+    /// Penetration [m]; negative for a gap.
+    depth: f64,
+    /// u·â: positive while the offset from the centreline grows along the axis [m].
+    growth: f64,
+}
+
+impl LinkInTube<'_> {
+    /// The station at axial position `s` [m]. `None` where the axis is on
+    /// the centreline or the station is past the tube's open ends.
+    fn station(&self, s: f64) -> Option<Station> {
+        let q = self.centre + s * self.axis;
+        let c = self.tube.nearest(&q)?;
+        let u = q - c.point;
+        let across = u - u.dot(&self.axis) * self.axis;
+        let len = across.norm();
+        if len < 1e-15 {
+            return None;
+        }
+        let w = q + self.radius * across / len;
+        let cw = self.tube.nearest(&w)?;
+        let rw = w - cw.point;
+        let d = rw.norm();
+        if d < 1e-15 {
+            return None;
+        }
+        let depth = d - self.tube.inner_radius;
+        let out = rw / d;
+        Some(Station {
+            point: w - 0.5 * depth * out,
+            normal: -out,
+            depth,
+            growth: u.dot(&self.axis),
+        })
+    }
+
+    /// Signed depth at `s` [m], −∞ where there is no station.
+    fn depth(&self, s: f64) -> f64 {
+        self.station(s).map_or(f64::NEG_INFINITY, |st| st.depth)
+    }
+
+    /// The axial position of the largest depth in `[a, b]`, by golden-section
+    /// search to 1e-12 of the positions.
+    fn deepest(&self, a: f64, b: f64) -> f64 {
+        const G: f64 = 0.618_033_988_749_894_8;
+        let (mut a, mut b) = (a, b);
+        let (mut c, mut d) = (b - G * (b - a), a + G * (b - a));
+        let (mut fc, mut fd) = (self.depth(c), self.depth(d));
+        while b - a > 1e-12 * (1.0 + b.abs().max(a.abs())) {
+            if fc > fd {
+                (b, d, fd) = (d, c, fc);
+                c = b - G * (b - a);
+                fc = self.depth(c);
+            } else {
+                (a, c, fc) = (c, d, fd);
+                d = a + G * (b - a);
+                fd = self.depth(d);
+            }
+        }
+        0.5 * (a + b)
+    }
+}
+
+/// One contact patch under construction (tube frame).
+#[derive(Default)]
+struct Patch {
+    /// Largest penetration [m] and the sample nearest where it is.
+    depth: f64,
+    slot: usize,
+    /// Σ δ_k, Σ δ_k·p_k [m²] and Σ δ_k·n_k [m] over the patch's samples.
+    weight: f64,
+    point: Vec3,
+    normal: Vec3,
+}
+
+impl Patch {
+    /// Adds a sampled surface point of the patch.
+    fn add(&mut self, k: usize, st: &Station) {
+        self.deepen(k, st.depth);
+        self.weight += st.depth;
+        self.point += st.depth * st.point;
+        self.normal += st.depth * st.normal;
+    }
+
+    /// Raises the patch's largest penetration to `depth` if deeper.
+    fn deepen(&mut self, k: usize, depth: f64) {
+        if depth > self.depth {
+            self.depth = depth;
+            self.slot = k;
+        }
+    }
+
+    /// The patch's contact point, body frames mapped by the tube pose `pt`.
+    fn contact(&self, pt: (&Vec3, &Quat)) -> ContactPoint {
+        ContactPoint {
+            slot: self.slot as u32,
+            point: pt.0 + pt.1 * (self.point / self.weight),
+            normal: pt.1 * self.normal.normalize(),
+            depth: self.depth,
+        }
+    }
+}
+
+/// Contact points of a cylinder (`radius`, `half_length`, axis along its
+/// body x) at pose `pc` inside tube `t` at pose `pt`: one per patch.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn cylinder_tube(
+    t: &TubePath,
+    pt: (&Vec3, &Quat),
+    radius: f64,
+    half_length: f64,
+    points: u32,
+    pc: (&Vec3, &Quat),
+    out: &mut Vec<ContactPoint>,
+) {
+    let inv = pt.1.inverse();
+    let link = LinkInTube {
+        tube: t,
+        centre: inv * (pc.0 - pt.0),
+        axis: inv * (pc.1 * Vec3::x()),
+        radius,
+    };
+    let n = points.max(2) as usize;
+    let s: Vec<f64> = (0..n)
+        .map(|k| -half_length + 2.0 * half_length * k as f64 / (n - 1) as f64)
+        .collect();
+    let stations: Vec<Option<Station>> = s.iter().map(|&x| link.station(x)).collect();
+    let touching = |k: usize| stations[k].as_ref().filter(|st| st.depth > 0.0);
+    let mut open: Option<Patch> = None;
+    // A hidden maximum just before a patch opens belongs to it.
+    let mut pending: Option<(usize, f64)> = None;
+    for k in 0..n {
+        if let Some(st) = touching(k) {
+            let p = open.get_or_insert_with(Patch::default);
+            if let Some((j, d)) = pending.take() {
+                p.deepen(j, d);
+            }
+            p.add(k, st);
+        } else if let Some(p) = open.take() {
+            out.push(p.contact(pt));
+        }
+        let Some((x, d)) = interior_maximum(&link, &s, &stations, k) else {
+            continue;
+        };
+        let j = if x - s[k] < s[k + 1] - x { k } else { k + 1 };
+        match (&mut open, touching(k + 1)) {
+            (Some(p), _) => p.deepen(j, d),
+            (None, Some(_)) => pending = Some((j, d)),
+            (None, None) => {
+                if let Some(st) = link.station(x) {
+                    let mut p = Patch::default();
+                    p.add(j, &st);
+                    out.push(p.contact(pt));
+                }
+            }
+        }
+    }
+    if let Some(p) = open {
+        out.push(p.contact(pt));
+    }
+}
+
+/// The interior depth maximum between samples `k` and `k + 1` [m, m], if
+/// one lies there and is in contact.
+fn interior_maximum(
+    link: &LinkInTube<'_>,
+    s: &[f64],
+    stations: &[Option<Station>],
+    k: usize,
+) -> Option<(f64, f64)> {
+    let (a, b) = (stations[k].as_ref()?, stations.get(k + 1)?.as_ref()?);
+    if !(a.growth > 0.0 && b.growth <= 0.0) {
+        return None;
+    }
+    let x = link.deepest(s[k], s[k + 1]);
+    let d = link.depth(x);
+    (d > 0.0).then_some((x, d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{PairGeometry, Shape, TubeSegment};
+    use super::*;
+    use approx::assert_relative_eq;
+
+    fn contacts(
+        tube: &Shape,
+        half_length: f64,
+        points: u32,
+        pc: (Vec3, Quat),
+    ) -> Vec<ContactPoint> {
+        let cyl = Shape::Cylinder {
+            radius: 0.043,
+            half_length,
+        };
+        let mut out = vec![];
+        PairGeometry::CylinderTube { points }.contacts(
+            tube,
+            (&Vec3::zeros(), &Quat::identity()),
+            &cyl,
+            (&pc.0, &pc.1),
+            &mut out,
+        );
+        out
+    }
+
+    fn straight() -> Shape {
+        Shape::Tube(TubePath::new(
+            0.058,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::x(),
+            &[TubeSegment::Straight { length: 2.0 }],
+        ))
+    }
+
+    #[test]
+    fn a_link_pressed_uniformly_gets_one_point_at_its_depth_for_any_sampling() {
+        // Centre 15.1 mm below the axis: 43 + 15.1 − 58 = 0.1 mm into the wall all along.
+        for points in [2, 5, 9, 17] {
+            let out = contacts(
+                &straight(),
+                0.1,
+                points,
+                (Vec3::new(0.0, 0.0, -0.0151), Quat::identity()),
+            );
+            assert_eq!(out.len(), 1, "{points} samples");
+            assert_relative_eq!(out[0].depth, 1e-4, epsilon = 1e-12);
+            assert_relative_eq!(out[0].normal, Vec3::z(), epsilon = 1e-12);
+            // The centre of pressure of a uniform patch is the link's middle.
+            assert_relative_eq!(out[0].point.x, 0.0, epsilon = 1e-12);
+        }
+    }
+
+    #[test]
+    fn a_tilted_link_touches_at_its_lower_rim_only() {
+        // Tilted by 0.01 rad about y, centre 14.1 mm down: the rim at x = +0.1 m
+        // sits 0.1·sin(0.01) lower, its surface point 43·cos(0.01) mm below the
+        // axis: depth = 0.0141 + 0.1 sin θ + 0.043 cos θ − 0.058 = 0.098 mm, and
+        // the wall is reached only within 9.8 mm of the rim, less than the
+        // 12.5 mm between 17 samples: one patch at the rim, the single-point law.
+        let th: f64 = 0.01;
+        let q = Quat::from_axis_angle(&Vec3::y_axis(), th);
+        for points in [5, 17] {
+            let out = contacts(&straight(), 0.1, points, (Vec3::new(0.0, 0.0, -0.0141), q));
+            assert_eq!(out.len(), 1, "{points} samples");
+            let expect = 0.0141 + 0.1 * th.sin() + 0.043 * th.cos() - 0.058;
+            assert_relative_eq!(out[0].depth, expect, epsilon = 1e-12);
+            assert_eq!(out[0].slot, points - 1);
+            // The patch acts at the rim: its surface point, 0.1 m along the axis.
+            let rim = q * Vec3::new(0.1, 0.0, -0.043) + Vec3::new(0.0, 0.0, -0.0141);
+            assert_relative_eq!(out[0].point.x, rim.x, epsilon = 1e-9);
+        }
+    }
+
+    #[test]
+    fn a_chord_against_the_inner_wall_is_found_between_samples() {
+        // An arc of centreline radius 0.5 m about O = (0.5, 0, 0) (tube starting at
+        // the origin along −z, bending toward +x). A straight link of half-length
+        // 0.2 m on the chord at distance h from O, perpendicular to the radius
+        // through the arc's midpoint: its axis points are √(h² + s²) from O, so
+        // the surface point nearest O penetrates the inner wall by
+        // 0.5 − √(h² + s²) + 0.043 − 0.058, largest at s = 0. With h chosen for a
+        // 0.1 mm penetration there, the samples at ±0.2/3 m are out of contact.
+        let tube = Shape::Tube(TubePath::new(
+            0.058,
+            Vec3::zeros(),
+            -Vec3::z(),
+            &[TubeSegment::Arc {
+                radius: 0.5,
+                angle: std::f64::consts::FRAC_PI_2,
+                bend: Vec3::x(),
+            }],
+        ));
+        let o = Vec3::new(0.5, 0.0, 0.0);
+        let mid = std::f64::consts::FRAC_PI_4;
+        let radial = Vec3::new(-mid.cos(), 0.0, -mid.sin()); // from O toward the arc's midpoint
+        let h = 0.5 + 0.043 - 0.058 - 1e-4;
+        let centre = o + h * radial;
+        // The link's x axis along the chord (perpendicular to `radial` in the bend plane).
+        let q = Quat::rotation_between(&Vec3::x(), &Vec3::new(-radial.z, 0.0, radial.x)).unwrap();
+        let side = 0.5 - (h * h + (0.2_f64 / 3.0).powi(2)).sqrt() + 0.043 - 0.058;
+        assert!(
+            side < 0.0,
+            "the samples beside the middle must be out of contact"
+        );
+        for points in [4, 5, 17] {
+            let out = contacts(&tube, 0.2, points, (centre, q));
+            // The rims touch the outer wall; the middle, alone, the inner wall.
+            assert_eq!(out.len(), 3, "{points} samples");
+            let middle = &out[1];
+            assert_relative_eq!(middle.depth, 1e-4, epsilon = 1e-9);
+            // The normal pushes the link away from O (from the inner wall outward).
+            assert_relative_eq!(middle.normal, radial, epsilon = 1e-6);
+            // Each rim: its surface point farthest out lies 43 mm beyond the
+            // axis, perpendicular to it, so (h + 0.043, ±0.2) from O in the bend plane.
+            let rim = ((h + 0.043).powi(2) + 0.04_f64).sqrt() - 0.5 - 0.058;
+            assert_relative_eq!(out[0].depth, rim, epsilon = 1e-9);
+            assert_relative_eq!(out[2].depth, rim, epsilon = 1e-9);
+        }
+    }
+}
