@@ -41,6 +41,7 @@ impl DrillPipeSpec {
     pub fn expand(&self) -> Result<Expansion, SceneError> {
         self.validate()?;
         let placement = Placement::new(self);
+        placement.check_fit(self)?;
         let mut b = Builder::new(self, &placement);
         b.chain_bodies();
         b.tube_contacts();
@@ -118,6 +119,52 @@ impl Placement {
             rotations,
             centreline,
         }
+    }
+}
+
+impl Placement {
+    /// Refuses a tube the chain cannot be placed in: a link longer than
+    /// eq. (9) allows, or a hinge bent beyond its articulation limit.
+    fn check_fit(&self, spec: &DrillPipeSpec) -> Result<(), SceneError> {
+        let (p, r) = (&spec.pipe, spec.borehole.curvature_radius);
+        let fit = super::sizing::tightest_radius_for_link(
+            p.pitch,
+            spec.borehole.inner_diameter,
+            p.link_diameter / 2.0,
+        );
+        if r < fit {
+            return Err(SceneError::new(
+                "borehole.curvature_radius",
+                r,
+                format!(
+                    "a {} m link of Ø{} m does not fit a Ø{} m tube bent this tightly: \
+                     eq. (9) needs R ≥ {fit:.4} m",
+                    p.pitch, p.link_diameter, spec.borehole.inner_diameter
+                ),
+            ));
+        }
+        let limit = spec.bend_limit_deg();
+        let (h, bend) = (0..self.axes.len() - 1)
+            .map(|h| {
+                (
+                    h,
+                    crate::math::angle_between(&self.axes[h], &self.axes[h + 1]).to_degrees(),
+                )
+            })
+            .fold((0, 0.0), |m, x| if x.1 > m.1 { x } else { m });
+        if bend > limit * (1.0 + 1e-9) {
+            return Err(SceneError::new(
+                "borehole.curvature_radius",
+                r,
+                format!(
+                    "placed on this arc, hinge {h} bends {bend:.2}°, beyond the hinge's \
+                     articulation limit of {limit}°; chains of two or more links need \
+                     R ≥ {:.4} m",
+                    spec.tightest_radius()
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -452,8 +499,14 @@ impl<'a> Builder<'a> {
             position: arr(&(self.place.hinges[h] + self.place.rotations[h] * p_hinge)),
             ..blank_body()
         };
-        self.push_body(body);
-        let mut layout = KeyLayout::default();
+        let (c_head, c_seat) = self.hinge_anchors(h);
+        let mut layout = KeyLayout {
+            body: self.push_body(body),
+            tangent: Self::key_tangent(j),
+            head_groove: c_head - kb.groove_offset * Vec3::x(),
+            seat_groove: c_seat + kb.groove_offset * Vec3::x(),
+            ..KeyLayout::default()
+        };
         self.race_flanks(h, j, [head, seat], &mut layout);
         self.window_faces(h, j, &mut layout);
         layout

@@ -68,9 +68,19 @@ impl PairPart {
     }
 }
 
-/// Pair ids of one ball key.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+/// One ball key: its body, its pairs, and its grooves' geometry.
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct KeyLayout {
+    /// Body id of the key.
+    pub body: usize,
+    /// Normal of the key's meridian plane (the grooves' cross-section
+    /// tangential direction), in the head body's and the seat body's frames
+    /// alike (they coincide when the hinge is straight).
+    pub tangent: Vec3,
+    /// Centre of the head groove's circle, head body frame [m].
+    pub head_groove: Vec3,
+    /// Centre of the seat groove's circle, seat body frame [m].
+    pub seat_groove: Vec3,
     /// Inner-race (head) flanks.
     pub inner: Vec<usize>,
     /// Outer-race (seat) flanks.
@@ -80,7 +90,7 @@ pub struct KeyLayout {
 }
 
 /// Pair ids of one hinge; empty for an ideal-CV hinge (no cage, no keys).
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct HingeLayout {
     /// Cage–head pair.
     pub cage_head: Option<usize>,

@@ -3,7 +3,7 @@
 //! `keys` and `drive`. Parts are identified by integer columns (`link`,
 //! `hinge`, `key`), never by names.
 
-use super::layout::{Feature, Layout};
+use super::layout::{Feature, KeyLayout, Layout};
 use super::spec::PipeTable;
 use crate::math::{Vec3, angle_between};
 use crate::model::Motion;
@@ -12,7 +12,7 @@ use crate::record::{
     col, contact_totals,
 };
 
-use ColumnKind::{F64, Name, OptU32, U32};
+use ColumnKind::{F64, Name, OptF64, OptU32, U32};
 
 /// Columns of the `links` table (drill pipe): one row per link per frame.
 const LINKS_COLUMNS: &[ColumnDef] = &[
@@ -157,6 +157,18 @@ const KEYS_COLUMNS: &[ColumnDef] = &[
         F64,
         "N",
         "friction force magnitude on the cage window faces",
+    ),
+    col(
+        "inner_contact_angle_deg",
+        OptF64,
+        "deg",
+        "operating contact angle on the inner race: the angle of the contact normal from the groove's radial direction, in the groove's cross-section, force-weighted over the flanks in contact (45 as designed); null without contact",
+    ),
+    col(
+        "outer_contact_angle_deg",
+        OptF64,
+        "deg",
+        "operating contact angle on the outer race, as inner_contact_angle_deg; null without contact",
     ),
 ];
 
@@ -411,13 +423,44 @@ fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
     }
 }
 
+/// The operating contact angle [deg] of key `key` on the race of body
+/// `race` (groove circle centred at `groove`, race body frame): for each
+/// flank point in contact, the angle of its normal from the groove's radial
+/// direction (ball centre away from the groove circle's centre, out of the
+/// meridian plane) in the groove's cross-section; force-weighted over the
+/// points of `pairs`. `None` without contact.
+fn contact_angle(
+    f: &Frame<'_>,
+    key: &KeyLayout,
+    race: usize,
+    groove: &Vec3,
+    pairs: &[usize],
+) -> Option<f64> {
+    let (s, q) = (f.state, f.state.rot[race]);
+    let e_t = q * key.tangent;
+    let r = s.pos[key.body] - (s.pos[race] + q * groove);
+    let e_r = (r - r.dot(&e_t) * e_t).try_normalize(1e-15)?;
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for &k in pairs {
+        for e in &f.contacts[k] {
+            let n = e.point.normal;
+            sum += e.normal_force * n.dot(&e_t).abs().atan2(n.dot(&e_r).abs());
+            weight += e.normal_force;
+        }
+    }
+    (weight > 0.0).then(|| (sum / weight).to_degrees())
+}
+
 fn keys(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
     let (step, t) = stamp(f);
     for (h, hinge) in layout.hinges.iter().enumerate() {
+        let (head, seat) = (layout.chain[h], layout.chain[h + 1]);
         for (j, key) in hinge.keys.iter().enumerate() {
             let (i_n, i_t) = contact_totals(f.contacts, &key.inner);
             let (o_n, o_t) = contact_totals(f.contacts, &key.outer);
             let (w_n, w_t) = contact_totals(f.contacts, &key.window);
+            let inner = contact_angle(f, key, head, &key.head_groove, &key.inner);
+            let outer = contact_angle(f, key, seat, &key.seat_groove, &key.outer);
             table.push(&[
                 step,
                 t,
@@ -429,6 +472,8 @@ fn keys(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
                 Cell::F64(o_t),
                 Cell::F64(w_n),
                 Cell::F64(w_t),
+                Cell::OptF64(inner),
+                Cell::OptF64(outer),
             ]);
         }
     }

@@ -28,6 +28,7 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
                 ColumnKind::U32 => DataType::UInt32,
                 ColumnKind::F64 => DataType::Float64,
                 ColumnKind::OptU32 => DataType::UInt32,
+                ColumnKind::OptF64 => DataType::Float64,
                 ColumnKind::Name(_) => {
                     DataType::Dictionary(Box::new(DataType::UInt32), Box::new(DataType::Utf8))
                 }
@@ -35,7 +36,8 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
             let mut md = HashMap::new();
             md.insert("unit".to_string(), c.unit.to_string());
             md.insert("description".to_string(), c.description.to_string());
-            Field::new(c.name, dt, c.kind == ColumnKind::OptU32).with_metadata(md)
+            let nullable = matches!(c.kind, ColumnKind::OptU32 | ColumnKind::OptF64);
+            Field::new(c.name, dt, nullable).with_metadata(md)
         })
         .collect();
     Schema::new_with_metadata(fields, metadata)
@@ -61,6 +63,7 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBa
                     (ColumnKind::U32, ColumnData::U32(v)) => Arc::new(UInt32Array::from(v)),
                     (ColumnKind::F64, ColumnData::F64(v)) => Arc::new(Float64Array::from(v)),
                     (ColumnKind::OptU32, ColumnData::OptU32(v)) => Arc::new(UInt32Array::from(v)),
+                    (ColumnKind::OptF64, ColumnData::OptF64(v)) => Arc::new(Float64Array::from(v)),
                     (ColumnKind::Name(dict), ColumnData::U32(v)) => {
                         let values = match dict {
                             Dictionary::Bodies => bodies.clone(),

@@ -28,6 +28,9 @@ pub enum ColumnKind {
     /// Unsigned 32-bit integer, or null where the column does not apply to
     /// the row (an id of a part the row has none of).
     OptU32,
+    /// 64-bit float, or null where the quantity does not exist in the row
+    /// (an angle of a contact that is not touching).
+    OptF64,
     /// A name, dictionary-encoded with u32 keys into a [`Dictionary`].
     Name(Dictionary),
 }
@@ -82,7 +85,7 @@ pub const fn col(
     }
 }
 
-use ColumnKind::{F64, Name, OptU32, U32, U64};
+use ColumnKind::{F64, Name, OptF64, OptU32, U32, U64};
 
 /// The frame's integrator step index, first column of every per-frame table.
 pub const STEP: ColumnDef = col("step", U64, "", "integrator step index of the frame");
@@ -350,6 +353,8 @@ pub enum Cell {
     F64(f64),
     /// For `OptU32` columns.
     OptU32(Option<u32>),
+    /// For `OptF64` columns.
+    OptF64(Option<f64>),
 }
 
 /// Column data.
@@ -363,6 +368,8 @@ pub enum ColumnData {
     F64(Vec<f64>),
     /// u32 values or nulls.
     OptU32(Vec<Option<u32>>),
+    /// f64 values or nulls.
+    OptF64(Vec<Option<f64>>),
 }
 
 /// Columnar buffers of one table.
@@ -387,6 +394,7 @@ impl TableBuffer {
                 U32 | Name(_) => ColumnData::U32(Vec::new()),
                 F64 => ColumnData::F64(Vec::new()),
                 OptU32 => ColumnData::OptU32(Vec::new()),
+                OptF64 => ColumnData::OptF64(Vec::new()),
             })
             .collect();
         Self { def, data, rows: 0 }
@@ -412,6 +420,7 @@ impl TableBuffer {
                 (ColumnData::U32(d), Cell::U32(v)) => d.push(*v),
                 (ColumnData::F64(d), Cell::F64(v)) => d.push(*v),
                 (ColumnData::OptU32(d), Cell::OptU32(v)) => d.push(*v),
+                (ColumnData::OptF64(d), Cell::OptF64(v)) => d.push(*v),
                 (d, v) => panic!(
                     "cell {v:?} does not fit column {d:?} of table {}",
                     self.def.name
