@@ -170,12 +170,15 @@ fn section_model(torque: f64, k: f64, n: f64, s: f64) -> (f64, f64) {
     (k * d.powf(n), u / pcr)
 }
 
+/// Per key of both hinges, (inner race, outer race) values.
+type PerKey = Vec<(f64, f64)>;
+
 /// A 1-link pipe in a straight bore (two hinges in series), drive held at
 /// rest, 1.8 kN·m ramped onto the lower connector, no gravity; returns each
 /// key's (head-race, seat-race) normal force [N], the lower connector's turn
 /// [rad], and every key's (inner, outer) operating contact angle [deg] from
 /// the last frame of the `keys` table.
-fn quasi_static_hinges(extra: &[&str]) -> (Vec<(f64, f64)>, f64, Vec<(f64, f64)>) {
+fn quasi_static_hinges(extra: &[&str]) -> (PerKey, f64, PerKey) {
     let mut o: Vec<String> = [
         "pipe.joints=1",
         "borehole.curvature_radius=1000",
