@@ -156,3 +156,42 @@ def test_write_returns_the_paths_and_creates_the_directory(tmp_path, ball_drop_p
     assert all(p.is_file() for p in paths.values())
     assert _leftovers(out) == []
     assert pq.read_table(paths["bodies"]).equals(run.bodies)
+
+
+def test_reusing_an_output_folder_removes_the_earlier_runs_tables(tmp_path):
+    out = tmp_path / "out"
+    three = 'record.tables=["bodies", "contacts", "energy"]'
+    assert _cli("run", str(BALL_DROP), "--out", str(out), "--quiet", "--set", three).returncode == 0
+    assert (out / "energy.parquet").exists()
+    (out / "notes.txt").write_text("mine")
+    proc = _cli("run", str(BALL_DROP), "--out", str(out), "--quiet", "--set", 'record.tables=["bodies"]')
+    assert proc.returncode == 0, proc.stderr
+    # Only this run's tables remain beside its scene.toml; files ballcage did not write stay.
+    assert sorted(p.name for p in out.glob("*.parquet")) == ["bodies.parquet"]
+    assert (out / "notes.txt").read_text() == "mine"
+
+
+def test_ctrl_c_writes_what_was_computed_marked_incomplete(tmp_path, monkeypatch, capsys):
+    # An interrupt arrives between two chunks of the run (as Ctrl-C does, once
+    # the native step returns): the tables so far are written, marked incomplete.
+    import ballcage.cli
+    import ballcage.run
+
+    calls = {"n": 0}
+    real_update = ballcage.run._ProgressBar.update
+
+    def interrupt_on_the_tenth(self, t):
+        calls["n"] += 1
+        if calls["n"] == 10:
+            raise KeyboardInterrupt
+        real_update(self, t)
+
+    monkeypatch.setattr(ballcage.run._ProgressBar, "update", interrupt_on_the_tenth)
+    out = tmp_path / "out"
+    code = ballcage.cli.main(["run", str(BALL_DROP), "--out", str(out), "--quiet"])
+    assert code == 130
+    assert "interrupted at t =" in capsys.readouterr().err
+    bodies = pq.read_table(out / "bodies.parquet")
+    assert bodies.schema.metadata[b"ballcage.complete"] == b"false"
+    full = ballcage.simulate(BALL_DROP).bodies
+    assert 0 < bodies.num_rows < full.num_rows

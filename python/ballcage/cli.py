@@ -316,7 +316,7 @@ def _run(args: argparse.Namespace) -> int:
     scene = _load_cli_scene(args.scene, overrides)
     try:
         result = simulate(scene, progress=False if args.quiet else None)
-    except _native.SimulationError as e:
+    except (_native.SimulationError, KeyboardInterrupt) as e:
         partial = getattr(e, "run", None)
         if partial is None:
             raise
@@ -324,7 +324,8 @@ def _run(args: argparse.Namespace) -> int:
         if not args.quiet:
             for name, path in paths.items():
                 print(_summary(name, path, partial.tables.get(name)))
-        return _fail(f"{e}; the output in {out} is incomplete (written up to the failure, ballcage.complete = false)", 1)
+        code = 130 if isinstance(e, KeyboardInterrupt) else 1
+        return _fail(f"{partial.error}; the output in {out} is incomplete (written up to then, ballcage.complete = false)", code)
     paths = result.write(out)
     if not args.quiet:
         for name, path in paths.items():

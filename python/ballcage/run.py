@@ -103,7 +103,10 @@ class Run:
         The directory is created if needed. Each file is written atomically:
         a reader sees either the previous file or the complete new one, and a
         failed write leaves no file under the final name and no temporary file.
-        Returns the written paths, keyed by table name and ``"scene"``.
+        Tables of an earlier run in the same directory that this run did not
+        record (``<table>.parquet`` for a name in ``ballcage.TABLE_NAMES``) are
+        removed afterwards, so the folder never mixes two runs; other files
+        are left alone. Returns the written paths, keyed by table name and ``"scene"``.
         """
         import pyarrow.parquet as pq  # deferred: only writers pay for it
 
@@ -121,6 +124,9 @@ class Run:
         scene_path = out / "scene.toml"
         write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
         written["scene"] = scene_path
+        for name in _native.TABLE_NAMES:
+            if name not in self.tables:
+                (out / f"{name}.parquet").unlink(missing_ok=True)
         return written
 
     def _table(self, name: str) -> pa.Table:
@@ -155,7 +161,9 @@ def simulate(
     `ballcage.SimulationError` when the run diverges. The error then carries
     what was recorded up to the failure as ``e.run``, a `Run` whose metadata
     has ``ballcage.complete = "false"`` and ``ballcage.error`` (the message);
-    ``e.run.write(dir)`` writes it like a complete run.
+    ``e.run.write(dir)`` writes it like a complete run. An interrupt
+    (Ctrl-C, `KeyboardInterrupt`) is re-raised the same way, carrying the
+    frames recorded so far as ``e.run`` (``Run.error`` says when it stopped).
     """
     resolved = load_scene(scene, overrides)
     sim = _native.Simulation(resolved)
@@ -169,6 +177,10 @@ def simulate(
         # The native Simulation stays usable after an error: hand over what it
         # recorded (its metadata has ballcage.complete = "false" and ballcage.error).
         e.run = Run(sim.finish(), resolved.to_toml(), error=str(e), scene=resolved)  # type: ignore[attr-defined]
+        raise
+    except KeyboardInterrupt as e:
+        reason = f"interrupted at t = {sim.time:.6g} s of {duration:.6g} s"
+        e.run = Run(sim.finish(), resolved.to_toml(), error=reason, scene=resolved)  # type: ignore[attr-defined]
         raise
     finally:
         bar.close()
