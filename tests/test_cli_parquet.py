@@ -164,7 +164,14 @@ def test_reusing_an_output_folder_removes_the_earlier_runs_tables(tmp_path):
     assert _cli("run", str(BALL_DROP), "--out", str(out), "--quiet", "--set", three).returncode == 0
     assert (out / "energy.parquet").exists()
     (out / "notes.txt").write_text("mine")
-    proc = _cli("run", str(BALL_DROP), "--out", str(out), "--quiet", "--set", 'record.tables=["bodies"]')
+    # Without --overwrite the folder of another run is refused, naming what it holds.
+    refused = _cli("run", str(BALL_DROP), "--out", str(out), "--quiet")
+    assert refused.returncode == 2
+    assert "--overwrite" in refused.stderr and "energy.parquet" in refused.stderr
+    assert (out / "energy.parquet").exists()
+    proc = _cli(
+        "run", str(BALL_DROP), "--out", str(out), "--quiet", "--overwrite", "--set", 'record.tables=["bodies"]'
+    )
     assert proc.returncode == 0, proc.stderr
     # Only this run's tables remain beside its scene.toml; files ballcage did not write stay.
     assert sorted(p.name for p in out.glob("*.parquet")) == ["bodies.parquet"]
@@ -195,3 +202,45 @@ def test_ctrl_c_writes_what_was_computed_marked_incomplete(tmp_path, monkeypatch
     assert bodies.schema.metadata[b"ballcage.complete"] == b"false"
     full = ballcage.simulate(BALL_DROP).bodies
     assert 0 < bodies.num_rows < full.num_rows
+
+
+def test_every_parquet_file_carries_units_and_descriptions_as_key_value_metadata(cli_out):
+    # What DuckDB's parquet_kv_metadata() and polars see: the file's raw
+    # key-value pairs, read here without decoding the Arrow schema.
+    import json
+
+    out, _ = cli_out
+    raw = pq.read_metadata(out / "bodies.parquet").metadata
+    units = json.loads(raw[b"ballcage.units"])
+    descriptions = json.loads(raw[b"ballcage.descriptions"])
+    assert units["pos_z"] == "m" and units["vel_x"] == "m/s" and units["t"] == "s"
+    assert "world frame" in descriptions["pos_x"]
+    assert set(units) == set(pq.read_table(out / "bodies.parquet").column_names)
+
+
+def test_a_real_sigint_leaves_readable_tables_marked_incomplete(tmp_path):
+    # The paper scene runs ~40 s; the progress lines on stderr (one per 10 %)
+    # say the run is under way; SIGINT then arrives mid-run.
+    import signal
+
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "ballcage", "run", "--out", str(out), "--set", "pipe.joints=4"],
+        stderr=subprocess.PIPE,
+        stdout=subprocess.DEVNULL,
+        text=True,
+    )
+    try:
+        assert proc.stderr is not None
+        for line in proc.stderr:
+            if "%" in line:
+                break
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, err
+    assert "interrupted at t =" in err
+    table = pq.read_table(out / "bodies.parquet")
+    assert table.schema.metadata[b"ballcage.complete"] == b"false"
+    assert 0 < table.column("t").to_numpy().max() < 1.8

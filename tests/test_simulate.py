@@ -191,3 +191,11 @@ def test_run_scene_answers_for_the_scene_it_ran(free_fall):
     rebuilt = ballcage.Run(run.tables, run.scene_toml)
     assert rebuilt.scene.to_toml() == run.scene_toml
     assert rebuilt.scene is rebuilt.scene
+
+
+def test_the_package_namespace_holds_only_its_api_and_modules():
+    import types
+
+    public = {n for n in vars(ballcage) if not n.startswith("_")}
+    modules = {n for n in public if isinstance(getattr(ballcage, n), types.ModuleType)}
+    assert public - modules == {n for n in ballcage.__all__ if not n.startswith("_")}

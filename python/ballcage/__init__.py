@@ -20,11 +20,9 @@ each integrator's step costs in error and where it stops being stable
 (``ballcage accuracy``, ``ballcage stability``).
 """
 
-from __future__ import annotations
-
-import importlib
-import warnings
-from typing import Any
+import importlib as _importlib
+import warnings as _warnings
+from typing import Any as _Any
 
 from ballcage import _native
 from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
@@ -47,20 +45,20 @@ __all__ = [
     "table_schema",
 ]
 
-DEBUG_BUILD_MESSAGE = "ballcage was built without optimizations; runs are ~10x slower: pip install . builds release"
+_DEBUG_BUILD_MESSAGE = "ballcage was built without optimizations; runs are ~10x slower: pip install . builds release"
 
 
 def _warn_if_debug_build(build_profile: str) -> None:
     """Warns once, at import, when the extension was compiled without optimizations."""
     if build_profile == "debug":
-        warnings.warn(DEBUG_BUILD_MESSAGE, RuntimeWarning, stacklevel=3)
+        _warnings.warn(_DEBUG_BUILD_MESSAGE, RuntimeWarning, stacklevel=3)
 
 
 _warn_if_debug_build(_native.BUILD_PROFILE)
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> _Any:
     """Imports `ballcage.paper` and `ballcage.studies` (and with them matplotlib) only when first used."""
     if name in ("paper", "studies"):
-        return importlib.import_module(f"ballcage.{name}")
+        return _importlib.import_module(f"ballcage.{name}")
     raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

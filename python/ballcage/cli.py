@@ -65,7 +65,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except _study_error() as e:
         return _fail(str(e), 1)
     except OSError as e:
-        return _fail(f"cannot write output: {e}", 1)
+        return _fail(f"cannot write output: {e}", 3)
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
 
@@ -120,6 +120,11 @@ def _add_run_command(commands: _Commands) -> None:
         help="scene file (TOML); without it, the embedded paper scene (see `ballcage scene show`)",
     )
     _add_out_option(run)
+    run.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an earlier run's tables in --out (without it, a folder holding them is refused)",
+    )
     _add_set_option(run)
     _add_quiet_option(run, "no progress bar and no summary")
     run.set_defaults(command=_run)
@@ -310,9 +315,21 @@ def _load_cli_scene(arg: str | None, overrides: Sequence[str]) -> _native.Scene:
         raise UsageError(f"{arg}: not UTF-8 text ({e.reason} at byte {e.start})") from e
 
 
+def _earlier_run(out: Path) -> list[str]:
+    """Files of an earlier run in `out`: its ``<table>.parquet`` and ``scene.toml``."""
+    names = [f"{t}.parquet" for t in _native.TABLE_NAMES] + ["scene.toml"]
+    return [n for n in names if (out / n).exists()]
+
+
 def _run(args: argparse.Namespace) -> int:
     overrides = [_checked_override(o) for o in args.overrides]
     out = _checked_out(args.out)
+    earlier = _earlier_run(out)
+    if earlier and not args.overwrite:
+        raise UsageError(
+            f"--out {out} holds another run's output ({', '.join(earlier)}); "
+            "pass --overwrite to replace it, or choose another folder"
+        )
     scene = _load_cli_scene(args.scene, overrides)
     try:
         result = simulate(scene, progress=False if args.quiet else None)

@@ -46,6 +46,17 @@ fn missing_field_is_named() {
 }
 
 #[test]
+fn an_override_takes_the_path_an_error_prints() {
+    // `--set` accepts `bodies[1].mass`, the path errors name, as well as `bodies.1.mass`.
+    let e = error_of(GOOD, &["bodies[1].mass=-2"]);
+    assert_eq!(e.path, "bodies[1].mass");
+    assert_eq!(e.value, "-2");
+    let e = error_of(GOOD, &["bodies[7].mass=2"]);
+    assert_eq!(e.path, "bodies.7");
+    assert!(e.reason.contains("index out of range"), "{e}");
+}
+
+#[test]
 fn negative_mass_is_named_with_its_value() {
     let e = error_of(GOOD, &["bodies.1.mass=-2"]);
     assert_eq!(e.path, "bodies[1].mass");
@@ -130,4 +141,12 @@ fn resolved_scene_round_trips_through_toml() {
     let s = Scene::from_toml_str(GOOD, &[]).unwrap();
     let again = Scene::from_toml_str(&s.to_toml(), &[]).unwrap();
     assert_eq!(s, again);
+}
+
+#[test]
+fn a_wrong_type_is_named_in_words_not_rust_types() {
+    let e = error_of(GOOD, &["simulation.duration=\"abc\""]);
+    assert_eq!(e.path, "simulation.duration");
+    assert!(e.reason.contains("expected a number"), "{e}");
+    assert!(!e.reason.contains("f64"), "{e}");
 }

@@ -14,11 +14,22 @@ use arrow_schema::{ArrowError, DataType, Field, Schema};
 use crate::record::{ColumnData, ColumnKind, Dictionary, Recording, TableBuffer, TableDef};
 
 /// Arrow schema of a table, with `unit` and `description` in each field's
-/// metadata and the table's `ballcage.table` and `ballcage.row` in the
-/// schema's, besides `metadata`.
+/// metadata and, in the schema's (which Parquet writers keep as the file's
+/// key–value metadata, where DuckDB's `parquet_kv_metadata` and polars read
+/// it), the table's `ballcage.table` and `ballcage.row` and the JSON objects
+/// `ballcage.units` and `ballcage.descriptions` (column → text), besides
+/// `metadata`.
 pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema {
     metadata.insert("ballcage.table".to_string(), table.name.to_string());
     metadata.insert("ballcage.row".to_string(), table.row.to_string());
+    metadata.insert(
+        "ballcage.units".to_string(),
+        json_object(table.columns.iter().map(|c| (c.name, c.unit))),
+    );
+    metadata.insert(
+        "ballcage.descriptions".to_string(),
+        json_object(table.columns.iter().map(|c| (c.name, c.description))),
+    );
     let fields: Vec<Field> = table
         .columns
         .iter()
@@ -41,6 +52,30 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
         })
         .collect();
     Schema::new_with_metadata(fields, metadata)
+}
+
+/// A JSON object of string values, in the order given.
+fn json_object<'a>(pairs: impl Iterator<Item = (&'a str, &'a str)>) -> String {
+    let body: Vec<String> = pairs
+        .map(|(k, v)| format!("{}: {}", json_string(k), json_string(v)))
+        .collect();
+    format!("{{{}}}", body.join(", "))
+}
+
+/// A JSON string literal.
+fn json_string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
 }
 
 /// One record batch per recorded table, with the run metadata on each schema.
@@ -89,4 +124,19 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBa
         out.push((def, RecordBatch::try_new(schema, arrays)?));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_strings_escape_quotes_backslashes_and_control_characters() {
+        assert_eq!(json_string(r#"a "b" \ c"#), r#""a \"b\" \\ c""#);
+        assert_eq!(json_string("x\ny"), r#""x\u000ay""#);
+        assert_eq!(
+            json_object([("t", "s"), ("f", "N*m")].into_iter()),
+            r#"{"t": "s", "f": "N*m"}"#
+        );
+    }
 }

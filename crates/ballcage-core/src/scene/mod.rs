@@ -558,7 +558,7 @@ pub(crate) fn deserialize_with_path<T: serde::de::DeserializeOwned>(
         if path == "." {
             path.clear();
         }
-        let reason = first_line(&e.into_inner().to_string());
+        let reason = plain_types(&first_line(&e.into_inner().to_string()));
         // serde reports a missing field at its parent: name the field itself.
         if let Some(field) = reason
             .strip_prefix("missing field `")
@@ -585,6 +585,21 @@ pub(crate) fn parse_toml(text: &str) -> Result<toml::Table, SceneError> {
 pub(crate) fn to_toml_text<T: Serialize>(spec: &T) -> String {
     // Serializing plain data with finite numbers cannot fail.
     toml::to_string_pretty(spec).unwrap_or_else(|e| format!("# scene could not be written: {e}\n"))
+}
+
+/// serde's Rust type names in a message, in words a scene author knows.
+fn plain_types(reason: &str) -> String {
+    [
+        ("f64", "a number"),
+        ("u32", "a whole number ≥ 0"),
+        ("u64", "a whole number ≥ 0"),
+        ("usize", "a whole number ≥ 0"),
+        ("a boolean", "true or false"),
+    ]
+    .iter()
+    .fold(reason.to_string(), |r, (rust, plain)| {
+        r.replace(&format!("expected {rust}"), &format!("expected {plain}"))
+    })
 }
 
 fn first_line(s: &str) -> String {

@@ -2,7 +2,18 @@
 
 use crate::error::SceneError;
 
-/// Sets `key` (dotted; array elements by index, `bodies.1.mass`) to `value`
+/// The parts of a dotted key; a list element may be written `bodies.1.mass`
+/// or, as error messages print paths, `bodies[1].mass`.
+fn key_parts(key: &str) -> Vec<String> {
+    key.trim()
+        .replace('[', ".")
+        .replace(']', "")
+        .split('.')
+        .map(str::to_string)
+        .collect()
+}
+
+/// Sets `key` (dotted; array elements by index, `bodies.1.mass` or `bodies[1].mass`) to `value`
 /// parsed as a TOML value (`3`, `1e-4`, `"rk4"`, `[0, 0, -9.8]`); a value that
 /// does not parse as TOML is taken as a string.
 pub fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), SceneError> {
@@ -23,7 +34,7 @@ pub fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), Sc
         ));
     }
     let value = parse_value(raw);
-    let parts: Vec<&str> = key.split('.').collect();
+    let parts = key_parts(key);
     let mut cur: &mut toml::Value = root;
     for (i, part) in parts.iter().enumerate() {
         let last = i + 1 == parts.len();
@@ -31,10 +42,10 @@ pub fn apply_override(root: &mut toml::Value, assignment: &str) -> Result<(), Sc
         cur = match cur {
             toml::Value::Table(t) => {
                 if last {
-                    t.insert((*part).to_string(), value);
+                    t.insert(part.clone(), value);
                     return Ok(());
                 }
-                t.entry((*part).to_string())
+                t.entry(part.clone())
                     .or_insert_with(|| toml::Value::Table(toml::Table::new()))
             }
             toml::Value::Array(a) => {
@@ -80,11 +91,11 @@ fn parse_value(raw: &str) -> toml::Value {
 /// The value at dotted `key` (the syntax of [`apply_override`]) in `root`.
 pub fn lookup<'a>(root: &'a toml::Value, key: &str) -> Result<&'a toml::Value, SceneError> {
     let mut cur = root;
-    let parts: Vec<&str> = key.trim().split('.').collect();
+    let parts = key_parts(key);
     for (i, part) in parts.iter().enumerate() {
         let here = parts[..=i].join(".");
         cur = match cur {
-            toml::Value::Table(t) => t.get(*part).ok_or_else(|| {
+            toml::Value::Table(t) => t.get(part.as_str()).ok_or_else(|| {
                 let keys: Vec<&str> = t.keys().map(String::as_str).collect();
                 SceneError::new(
                     &here,
