@@ -144,7 +144,9 @@ def test_comparison_notes_suspect_values_and_unrun_sweeps(paper_out):
             assert "not run: pass --sweeps" in row["note"], key
         else:
             assert row["ours"] is not None and math.isfinite(row["ours"]), key
-        if row["ours"] is not None and row["paper"] is not None and row["paper"] != 0:
+        if key == "most_deformed_joint":
+            assert row["ratio"] is None and "no ratio" in row["note"], key  # an index
+        elif row["ours"] is not None and row["paper"] is not None and row["paper"] != 0:
             assert row["ratio"] == pytest.approx(row["ours"] / row["paper"]), key
         else:
             assert row["ratio"] is None, key
@@ -413,6 +415,8 @@ def test_table3_rows_on_a_hand_built_run():
     rows = {r["key"]: r for r in paper.comparison(_synthetic_run()).to_pylist()}
     # Phases 4, 6, 5, 4: the most frequent is 4 (a rounded mean would say 5).
     assert rows["most_deformed_joint"]["ours"] == 4.0
+    # A link number is an index: no ratio against the paper's link number.
+    assert rows["most_deformed_joint"]["ratio"] is None
     assert "per-phase most deformed links 4, 6, 5, 4: link 4 at 2 of 4 phases" in rows["most_deformed_joint"]["note"]
     assert "tie" not in rows["most_deformed_joint"]["note"].split("per-phase")[1]
     # Included angle at hinge k between link k and link k+1, k = 4, 6, 5, 4 at frames 3, 6, 9, 12.

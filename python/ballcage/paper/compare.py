@@ -42,6 +42,8 @@ COMPARISON_SCHEMA = pa.schema(
         pa.field("note", pa.string(), metadata={"description": "suspect values, differing definitions, details"}),
     ]
 )
+#: Rows whose value is an index (a link number): a ratio of two indices means nothing.
+INDEX_KEYS = frozenset({"most_deformed_joint"})
 #: A sweep row's key: ``sweep_<variant>_<what>_n``.
 _SWEEP_KEY = re.compile(r"^sweep_(?P<variant>[A-Za-z0-9]+)_(?P<what>tube_mean_max|key_peak)_n$")
 
@@ -125,7 +127,9 @@ def _row(spec: RowSpec, value: _Value) -> dict[str, Any]:
         notes.append(value.note)
     ours = value.ours if value.ours is not None and math.isfinite(value.ours) else None
     ratio = None
-    if ours is not None and spec.paper is not None:
+    if spec.key in INDEX_KEYS:
+        notes.append("an index, not a magnitude: no ratio")
+    elif ours is not None and spec.paper is not None:
         if spec.paper != 0.0:
             ratio = ours / spec.paper
         else:
