@@ -11,7 +11,7 @@
 //! Loading validates, expands and assembles once: a [`Document`] holds the
 //! assembled model, and every simulation of it starts from a copy.
 
-use crate::assembly::assemble;
+use crate::assembly::{assemble, assemble_validated};
 use crate::drillpipe::{self, DrillPipeSpec, Layout, PipeTables};
 use crate::error::SceneError;
 use crate::model::{Model, State};
@@ -106,7 +106,10 @@ impl Document {
         match Kind::of(&table)? {
             Kind::Generic => {
                 table.remove("kind");
-                Self::generic(Scene::from_table(table, overrides)?)
+                // The reader validates; assembly does not do it again.
+                let scene = Scene::from_table(table, overrides)?;
+                let (model, state) = assemble_validated(&scene)?;
+                Ok(Self::from_parts(Source::Generic, scene, model, state))
             }
             Kind::DrillPipe => {
                 // Sections and fields left out take the paper's values.
@@ -122,30 +125,31 @@ impl Document {
         }
     }
 
-    /// A generic scene (already validated by its reader).
+    /// A generic scene: validated and assembled.
     pub fn generic(scene: Scene) -> Result<Self, SceneError> {
         let (model, state) = assemble(&scene)?;
-        Ok(Self {
-            source: Source::Generic,
+        Ok(Self::from_parts(Source::Generic, scene, model, state))
+    }
+
+    /// A drill-pipe scene: validated, expanded (which validates the
+    /// expansion) and assembled.
+    pub fn drill_pipe(spec: DrillPipeSpec) -> Result<Self, SceneError> {
+        let expansion = spec.expand()?;
+        let (model, state) = assemble_validated(&expansion.scene)?;
+        let source = Source::DrillPipe {
+            spec: Box::new(spec),
+            layout: Box::new(expansion.layout),
+        };
+        Ok(Self::from_parts(source, expansion.scene, model, state))
+    }
+
+    fn from_parts(source: Source, scene: Scene, model: Model, state: State) -> Self {
+        Self {
+            source,
             scene,
             model,
             state,
-        })
-    }
-
-    /// A drill-pipe scene: validated, expanded and assembled.
-    pub fn drill_pipe(spec: DrillPipeSpec) -> Result<Self, SceneError> {
-        let expansion = spec.expand()?;
-        let (model, state) = assemble(&expansion.scene)?;
-        Ok(Self {
-            source: Source::DrillPipe {
-                spec: Box::new(spec),
-                layout: Box::new(expansion.layout),
-            },
-            scene: expansion.scene,
-            model,
-            state,
-        })
+        }
     }
 
     /// The document's kind.

@@ -30,6 +30,12 @@ use crate::scene::Scene;
 /// Validates the scene and builds its model and initial state.
 pub fn assemble(scene: &Scene) -> Result<(Model, State), SceneError> {
     scene.validate()?;
+    assemble_validated(scene)
+}
+
+/// Builds the model and initial state of a scene [`Scene::validate`] has
+/// accepted (a reader that validated it does not validate it again).
+pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
     let bodies = bodies::bodies(scene)?;
     let pairs = pairs::contact_pairs(scene, &bodies)?;
     let torques = joints::torque_loads(scene)?;
