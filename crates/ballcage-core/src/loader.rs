@@ -210,12 +210,12 @@ impl Document {
     /// Names of the tables a run of this document records, in order.
     pub fn table_names(&self) -> Vec<&'static str> {
         let engine = self.scene.record.tables.iter().map(|k| k.name());
-        let own = self
-            .observers()
-            .into_iter()
-            .flat_map(|o| o.tables())
-            .map(|t| t.name);
-        engine.chain(own).collect()
+        let own: &[drillpipe::PipeTable] = match &self.source {
+            Source::Generic => &[],
+            Source::DrillPipe { spec, .. } => &spec.record.tables,
+        };
+        let own = own.iter().filter_map(|t| drillpipe::tables::table_def(*t));
+        engine.chain(own.map(|t| t.name)).collect()
     }
 
     /// The observers of the document's own tables.

@@ -125,17 +125,24 @@ fn named_modules(text: &str) -> BTreeSet<String> {
     out
 }
 
-/// (file, module, named module) for every cross-module reference.
-fn references() -> Vec<(PathBuf, String, String)> {
+/// Every source file under `src/` but the crate root: (path, module, text).
+fn sources() -> Vec<(PathBuf, String, String)> {
     let mut files = vec![];
     rust_files(&src(), &mut files);
+    files
+        .into_iter()
+        .map(|f| {
+            let text = std::fs::read_to_string(&f).expect("readable file");
+            (f.clone(), module_of(&f), text)
+        })
+        .filter(|(_, module, _)| module != "lib")
+        .collect()
+}
+
+/// (file, module, named module) for every cross-module reference.
+fn references() -> Vec<(PathBuf, String, String)> {
     let mut out = vec![];
-    for f in files {
-        let module = module_of(&f);
-        if module == "lib" {
-            continue;
-        }
-        let text = std::fs::read_to_string(&f).expect("readable file");
+    for (f, module, text) in sources() {
         for named in named_modules(&text) {
             if named != module {
                 out.push((f.clone(), module.clone(), named));
@@ -183,12 +190,8 @@ fn no_generic_module_names_the_drill_pipe() {
         .map(|(m, _)| *m)
         .filter(|m| !["drillpipe", "loader"].contains(m))
         .collect();
-    let mut files = vec![];
-    rust_files(&src(), &mut files);
-    for f in files {
-        let module = module_of(&f);
+    for (f, module, text) in sources() {
         if generic.contains(&module.as_str()) {
-            let text = std::fs::read_to_string(&f).expect("readable file");
             assert!(
                 !text.contains("drillpipe") && !text.contains("DrillPipe"),
                 "{} names the drill pipe",

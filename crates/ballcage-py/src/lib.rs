@@ -48,25 +48,26 @@ struct Scene {
 }
 
 impl Scene {
-    /// The drill-pipe document, or a `SceneError` on `kind` naming `what` needs one.
+    /// The drill-pipe document and its layout, or a `SceneError` on `kind`
+    /// naming `what` needs one.
     fn drill_pipe(
         &self,
         py: Python<'_>,
         what: &str,
-    ) -> PyResult<&ballcage_core::drillpipe::DrillPipeSpec> {
-        self.inner
-            .drill_pipe_parts()
-            .map(|(spec, _)| spec)
-            .ok_or_else(|| {
-                scene_err(
-                    py,
-                    ballcage_core::SceneError::new(
-                        "kind",
-                        self.inner.kind().name(),
-                        format!("{what} needs a drill-pipe scene (kind = \"drill-pipe\")"),
-                    ),
-                )
-            })
+    ) -> PyResult<(
+        &ballcage_core::drillpipe::DrillPipeSpec,
+        &ballcage_core::drillpipe::Layout,
+    )> {
+        self.inner.drill_pipe_parts().ok_or_else(|| {
+            scene_err(
+                py,
+                ballcage_core::SceneError::new(
+                    "kind",
+                    self.inner.kind().name(),
+                    format!("{what} needs a drill-pipe scene (kind = \"drill-pipe\")"),
+                ),
+            )
+        })
     }
 }
 
@@ -156,18 +157,17 @@ impl Scene {
 
     /// The tightest guide-tube curvature radius [m] the drill pipe allows.
     fn tightest_radius(&self, py: Python<'_>) -> PyResult<f64> {
-        Ok(self.drill_pipe(py, "tightest_radius")?.tightest_radius())
+        Ok(self.drill_pipe(py, "tightest_radius")?.0.tightest_radius())
     }
 
     /// `count` points along the drill pipe's extended tube centreline.
     fn centreline<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
-        let spec = self.drill_pipe(py, "centreline")?;
+        let (spec, layout) = self.drill_pipe(py, "centreline")?;
         if count < 2 {
             return Err(PyValueError::new_err(format!(
                 "count = {count}: must be at least 2 points"
             )));
         }
-        let (_, layout) = self.inner.drill_pipe_parts().expect("checked above");
         let path = spec.extended_centreline();
         let (mut point, mut tangent, mut outward, mut s) = (vec![], vec![], vec![], vec![]);
         for i in 0..count {

@@ -167,60 +167,68 @@ pub(super) fn cylinder_tube(
         radius,
     };
     let n = points.max(2) as usize;
-    let s: Vec<f64> = (0..n)
-        .map(|k| -half_length + 2.0 * half_length * k as f64 / (n - 1) as f64)
-        .collect();
-    let stations: Vec<Option<Station>> = s.iter().map(|&x| link.station(x)).collect();
-    let touching = |k: usize| stations[k].as_ref().filter(|st| st.depth > 0.0);
+    let s = |k: usize| -half_length + 2.0 * half_length * k as f64 / (n - 1) as f64;
+    let touching = |st: &Option<Station>| st.as_ref().is_some_and(|st| st.depth > 0.0);
     let mut open: Option<Patch> = None;
     // A hidden maximum just before a patch opens belongs to it.
     let mut pending: Option<(usize, f64)> = None;
+    // Stations k and k + 1 only: no allocation per evaluation.
+    let mut here = link.station(s(0));
     for k in 0..n {
-        if let Some(st) = touching(k) {
-            let p = open.get_or_insert_with(Patch::default);
-            if let Some((j, d)) = pending.take() {
-                p.deepen(j, d);
-            }
-            p.add(k, st);
-        } else if let Some(p) = open.take() {
-            out.push(p.contact(pt));
-        }
-        let Some((x, d)) = interior_maximum(&link, &s, &stations, k) else {
-            continue;
+        let next = if k + 1 < n {
+            link.station(s(k + 1))
+        } else {
+            None
         };
-        let j = if x - s[k] < s[k + 1] - x { k } else { k + 1 };
-        match (&mut open, touching(k + 1)) {
-            (Some(p), _) => p.deepen(j, d),
-            (None, Some(_)) => pending = Some((j, d)),
-            (None, None) => {
-                if let Some(st) = link.station(x) {
-                    let mut p = Patch::default();
-                    p.add(j, &st);
+        match &here {
+            Some(st) if st.depth > 0.0 => {
+                let p = open.get_or_insert_with(Patch::default);
+                if let Some((j, d)) = pending.take() {
+                    p.deepen(j, d);
+                }
+                p.add(k, st);
+            }
+            _ => {
+                if let Some(p) = open.take() {
                     out.push(p.contact(pt));
                 }
             }
         }
+        if let Some((x, peak)) = interior_maximum(&link, (s(k), &here), (s(k + 1), &next)) {
+            let j = if x - s(k) < s(k + 1) - x { k } else { k + 1 };
+            match (&mut open, touching(&next)) {
+                (Some(p), _) => p.deepen(j, peak.depth),
+                (None, true) => pending = Some((j, peak.depth)),
+                (None, false) => {
+                    let mut p = Patch::default();
+                    p.add(j, &peak);
+                    out.push(p.contact(pt));
+                }
+            }
+        }
+        here = next;
     }
     if let Some(p) = open {
         out.push(p.contact(pt));
     }
 }
 
-/// The interior depth maximum between samples `k` and `k + 1` [m, m], if
-/// one lies there and is in contact.
+/// The interior depth maximum between two neighbouring samples (axial
+/// position [m] and station each), if one lies there and is in contact:
+/// its position [m] and station.
 fn interior_maximum(
     link: &LinkInTube<'_>,
-    s: &[f64],
-    stations: &[Option<Station>],
-    k: usize,
-) -> Option<(f64, f64)> {
-    let (a, b) = (stations[k].as_ref()?, stations.get(k + 1)?.as_ref()?);
+    (sa, a): (f64, &Option<Station>),
+    (sb, b): (f64, &Option<Station>),
+) -> Option<(f64, Station)> {
+    let (a, b) = (a.as_ref()?, b.as_ref()?);
     if !(a.growth > 0.0 && b.growth <= 0.0) {
         return None;
     }
-    let x = link.deepest(s[k], s[k + 1]);
-    let d = link.depth(x);
-    (d > 0.0).then_some((x, d))
+    let x = link.deepest(sa, sb);
+    link.station(x)
+        .filter(|st| st.depth > 0.0)
+        .map(|st| (x, st))
 }
 
 #[cfg(test)]
