@@ -20,8 +20,9 @@ def _cli(*args: str) -> subprocess.CompletedProcess[str]:
 def test_scene_show_prints_the_default_scene_which_loads_back(tmp_path):
     proc = _cli("scene", "show")
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout == _native.default_scene_toml()
+    assert proc.stdout == default_scene().to_toml(units=True)  # the same values, each with its unit
     parsed = tomllib.loads(proc.stdout)
+    assert parsed == tomllib.loads(_native.default_scene_toml())
     assert parsed["kind"] == "drill-pipe"
     assert parsed["pipe"]["joints"] == 12 and parsed["drive"]["speed_rpm"] == 100.0
     path = tmp_path / "paper.toml"
@@ -36,7 +37,9 @@ def test_run_without_a_scene_runs_the_paper_scene(tmp_path):
     proc = _cli("run", "--out", str(out), "--set", "simulation.duration=0.002", "--quiet")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "" and proc.stderr == ""
-    assert sorted(p.name for p in out.iterdir()) == ["bodies.parquet", "contacts.parquet", "scene.toml"]
+    # A drill pipe that does not choose its tables records the engineering ones besides its own.
+    tables = ["bodies", "contacts", "links", "hinges", "keys", "drive", "summary", "pairs"]
+    assert sorted(p.name for p in out.iterdir()) == sorted([f"{t}.parquet" for t in tables] + ["scene.toml"])
     bodies = pq.read_table(out / "bodies.parquet")
     names = set(bodies.column("body").cast("string").to_pylist())
     assert names == {"upper", "lower", *(f"link{k:02d}" for k in range(1, 13))}  # the chain, by default

@@ -11,6 +11,7 @@ import pytest
 
 import ballcage
 from ballcage import cli
+from ballcage.scene import default_scene
 
 M, R, K = 1.0, 0.05, 1e8  # kg, m, N/m
 DT = 1e-3  # s: h·ω = DT·sqrt(2K/M) ≈ 14, far beyond symplectic Euler's bound of 2
@@ -139,3 +140,66 @@ def test_cli_quiet_still_writes_and_reports_one_line(tmp_path, capsys):
     assert captured.out == ""
     assert len(captured.err.strip().splitlines()) == 1
     assert (tmp_path / "q" / "bodies.parquet").is_file()
+
+
+# --------------------------------------------------------------------------- the advice in the message
+
+
+def overlapping_ball(integrator: str, dt: float) -> ballcage.SceneBuilder:
+    """A ball of radius 50 mm placed 20 mm deep in the ground: beyond its pair's limit (25 % of the
+    radius, 12.5 mm) from the start, whatever the step."""
+    return (
+        ballcage.SceneBuilder("overlap")
+        .simulation(duration=0.05, dt=dt, output_interval=1e-3, integrator=integrator)
+        .gravity([0.0, 0.0, -9.81])
+        .body("ground", motion="fixed", shape={"type": "half-space", "normal": [0.0, 0.0, 1.0]})
+        .body("ball", shape={"type": "ball", "radius": R}, mass=M, position=[0.0, 0.0, R - 0.02])
+        .contact("ground", "ball", normal={"law": "hertz", "stiffness": 1e8})
+    )
+
+
+def _advised_step(message: str) -> float | None:
+    match = re.search(r"simulation\.dt ≤ ([-+0-9.eE]+) s", message)
+    return float(match.group(1)) if match else None
+
+
+@pytest.mark.parametrize(("integrator", "dt"), [("symplectic-euler", 1e-3), ("rk4", 1e-5), ("sdirk2", 1e-4)])
+def test_an_initial_overlap_is_not_blamed_on_the_step(integrator, dt):
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(overlapping_ball(integrator, dt))
+    text = str(info.value)
+    assert "already penetrates 20.0000 mm at t = 0" in text and "initial overlap" in text, text
+    assert "is probably not the cause" in text, text
+    assert "geometry" in text and "too soft" in text and "load" in text, text
+    assert _advised_step(text) is None, text
+    # Following the old advice (a smaller step) would fail at once again: same advice.
+    with pytest.raises(ballcage.SimulationError) as again:
+        ballcage.simulate(overlapping_ball(integrator, dt / 4))
+    assert "is probably not the cause" in str(again.value)
+
+
+def test_a_step_too_large_still_gets_the_step_advice_which_holds():
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(stiff_slot())
+    text = str(info.value)
+    advised = _advised_step(text)
+    assert advised is not None and advised < DT, text
+    assert "probably not the cause" not in text
+    # The advice holds: at half the advised step (a step that divides the output interval) the run completes.
+    steps = math.ceil(OUTPUT_INTERVAL / (0.5 * advised))
+    assert ballcage.simulate(stiff_slot().simulation(dt=OUTPUT_INTERVAL / steps)).complete
+
+
+def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
+    # One Newton iteration per stage cannot converge, however small the step: SDIRK2 halves the
+    # step four times and gives up; the message says the step is not the cause.
+    scene = default_scene(
+        ["pipe.joints=2", "simulation.duration=0.01", "simulation.dt=1e-3", "simulation.newton.max_iterations=1"]
+    )
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(scene)
+    text = str(info.value)
+    assert "retried in halves" in text and "is probably not the cause" in text, text
+    assert "simulation.newton.max_iterations" in text
+    assert _advised_step(text) is None, text
+

@@ -7,7 +7,7 @@ Limits are geometric (docs/model.md §3, §4), not numbers of an earlier run:
   (116 − 86)/2 = 15 mm, plus its contact penetration (< 1 mm under the
   Adams law at the forces involved);
 - a key centre stays at ≈ PCR = 31.5 mm from its cage's axis: the bisector
-  geometry moves it by ±c·sin(β/2) (0.52 mm at the 15° stop), flank clearance
+  geometry moves it by ±c·sin(β/2) (0.52 mm at 15°), flank clearance
   and penetration add up to 0.6 mm at 33.5 kN (docs/model.md §5), the cage
   clearances 0.02 mm: 1.5 mm bounds all of that, while a key out of its
   Gothic-arch groove would have to climb its ~2 mm depth;

@@ -343,15 +343,18 @@ def test_stability_heat_maps_are_written(slot_stability, tmp_path):
     assert set(paths) == {"parquet", "stability_stiffness", "md"}
 
 
-def test_tightest_radius_is_the_articulation_stop_over_the_pitch():
-    assert studies.tightest_radius() == pytest.approx(0.2 / (2 * math.sin(math.radians(7.5))), rel=1e-12)
-    assert studies.tightest_radius() == pytest.approx(0.766, abs=1e-3)
+def test_tightest_radius_is_the_articulation_limit_over_the_pitch():
+    # The neck (r = 21 mm) meets the cage rim (R_ci = 31 mm, cut at ±20 mm)
+    # at β = 2·(acos(21/31) − asin(20/31)); on an arc R = p / (2 sin(β/2)).
+    beta = 2 * (math.acos(21 / 31) - math.asin(20 / 31))
+    assert studies.tightest_radius() == pytest.approx(0.2 / (2 * math.sin(beta / 2)), rel=1e-12)
+    assert studies.tightest_radius() == pytest.approx(0.800, abs=1e-3)
 
 
-def test_tightest_radius_is_eq9_when_the_stop_allows_more():
-    # A 120° stop would allow R = 0.2 / (2 sin 60°) = 0.115 m; the 86 mm link
-    # in the 116 mm tube fits only down to R = 0.1² / (2·0.030) − 0.043 = 0.1237 m (eq. (9)).
-    scene = ballcage.load_scene({"kind": "drill-pipe", "pipe": {"ball_keys": {"bend_limit_deg": 120.0}}})
+def test_tightest_radius_is_eq9_without_an_articulation_limit():
+    # Without a neck contact nothing limits the bend; the 86 mm link in the
+    # 116 mm tube fits only down to R = 0.1² / (2·0.030) − 0.043 = 0.1237 m (eq. (9)).
+    scene = ballcage.load_scene({"kind": "drill-pipe", "pipe": {"neck_radius": 0.0}})
     assert studies.tightest_radius(scene) == pytest.approx(0.01 / 0.06 - 0.043, rel=1e-12)
     params = studies.drill_pipe_parameters(values_per_parameter=5)
     assert tuple(params) == studies.PARAMETER_NAMES == cli.STABILITY_PARAMETERS
@@ -402,7 +405,7 @@ def test_cli_stability_writes_the_files_and_exits_0(tmp_path, capsys):
     assert np.all(np.isfinite(table.column("max_stable_dt_s").to_numpy()))
     assert (out / "stability_key_mass.png").is_file()
     assert (out / "stability.md").is_file()
-    assert float(table.schema.metadata[b"ballcage.tightest_radius_m"]) == pytest.approx(0.766, abs=1e-3)
+    assert float(table.schema.metadata[b"ballcage.tightest_radius_m"]) == pytest.approx(0.770, abs=1e-3)
 
 
 @pytest.mark.parametrize(

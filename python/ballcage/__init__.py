@@ -26,6 +26,7 @@ from typing import Any as _Any
 
 from ballcage import _native
 from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
+from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
 
@@ -40,6 +41,7 @@ __all__ = [
     "Simulation",
     "SimulationError",
     "__version__",
+    "buckling",
     "load_scene",
     "simulate",
     "table_schema",

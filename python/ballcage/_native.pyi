@@ -39,10 +39,12 @@ SCENE_KINDS: list[str]
 class SceneError(ValueError):
     """A scene that cannot be read or validated.
 
-    ``str(e)`` reads ``scene field `bodies[1].mass` = -2: must be positive``.
+    ``str(e)`` reads ``scene field `bodies[1].mass` = -2: must be positive``;
+    an error of the text as a whole (``path`` empty) is its reason alone,
+    ``TOML syntax error at line 2, column 7: …``.
     """
 
-    #: Dotted path of the offending field, e.g. ``"bodies[1].mass"``.
+    #: Dotted path of the offending field, e.g. ``"bodies[1].mass"``; empty for a TOML syntax error.
     path: str
     #: The offending value as text; empty when the field is missing.
     value: str
@@ -67,8 +69,13 @@ class Scene:
     def from_dict(obj: dict[str, Any], overrides: Sequence[str] = ...) -> Scene:
         """Same as `from_toml` for a dict of the same structure. Raises `SceneError`."""
 
-    def to_toml(self) -> str:
-        """The resolved scene as TOML, with every default written out."""
+    def to_toml(self, *, units: bool = False) -> str:
+        """The resolved scene as TOML, with every default written out.
+
+        With `units`, each line that sets a number ends in a comment naming its
+        unit (``pitch = 0.2  # m``; contact laws in their own ``units``, e.g.
+        ``# N/mm^2.2``); the text parses to the same values.
+        """
 
     @property
     def name(self) -> str: ...
@@ -107,6 +114,12 @@ class Scene:
 
         Whichever binds first of the articulation limit, R = p / (2 sin(β_max / 2)),
         and the paper's eq. (9) for a rigid link in the tube. Raises `SceneError`
+        (path ``kind``) for a generic scene.
+        """
+
+    def articulation_limit_deg(self) -> float | None:
+        """The bend [deg] at which the drill pipe's hinges bind (where the head's neck meets
+        the seat's mouth); ``None`` when nothing limits the bend. Raises `SceneError`
         (path ``kind``) for a generic scene.
         """
 

@@ -13,7 +13,11 @@ if TYPE_CHECKING:
     from matplotlib.colors import Colormap
     from matplotlib.figure import Figure
 
-__all__ = ["colormap", "figure", "no_data"]
+__all__ = ["colormap", "figure", "no_data", "series_styles"]
+
+#: Line styles and markers that `series_styles` combines with colours.
+_LINE_STYLES = ("-", "--", "-.", ":")
+_MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*", "<", ">", "h", "p")
 
 
 def figure(**kwargs: Any) -> Figure:
@@ -28,6 +32,24 @@ def colormap(name: str) -> Colormap:
     import matplotlib
 
     return matplotlib.colormaps[name]
+
+
+def series_styles(count: int) -> list[dict[str, Any]]:
+    """`count` plot styles (``color``, ``ls``, ``marker``) that tell that many lines apart.
+
+    Colours come from the qualitative ``tab10`` palette; after every ten the
+    line style changes, and each line has its own marker, so neighbours in
+    the list never share a colour and no two share colour, style and marker.
+    """
+    colors = colormap("tab10").colors  # type: ignore[attr-defined]
+    return [
+        {
+            "color": colors[k % len(colors)],
+            "ls": _LINE_STYLES[(k // len(colors)) % len(_LINE_STYLES)],
+            "marker": _MARKERS[k % len(_MARKERS)],
+        }
+        for k in range(count)
+    ]
 
 
 def no_data(ax: Axes, text: str) -> None:

@@ -1,25 +1,30 @@
 """Command line: ``ballcage run``, ``paper``, ``accuracy``, ``stability``, ``scene show`` and ``schema``.
 
 ``ballcage run`` without a scene runs the embedded paper scene (Zhu et al.
-2023's drill pipe); ``ballcage scene show`` prints it as TOML to copy and edit.
+2023's drill pipe); ``ballcage scene show`` prints it (or a scene file) as TOML
+with every default and each number's unit, to copy and edit.
 ``ballcage paper`` runs it with every table recorded and writes the paper's
 figures and a comparison with its numbers (`ballcage.paper.run_paper`).
 ``ballcage accuracy`` and ``ballcage stability`` are the integrator studies of
 `ballcage.studies`.
 
-Exit codes: 0 success; 1 the run failed (`SimulationError`; ``ballcage run``
-then still writes what was recorded, marked incomplete) or its output could
-not be written; 2 bad input (an invalid scene, a missing file, a malformed
-``--set``, a usage error). Errors are one line on stderr,
+Exit codes: 0 success; 1 the run diverged (`SimulationError`; ``ballcage run``
+then still writes what was recorded, marked incomplete); 2 bad input (an
+invalid scene, a TOML syntax error, a missing file, a malformed ``--set``, an
+unknown ``--tables`` name, an ``--out`` folder holding another run, a usage
+error); 3 the output could not be written; 130 interrupted (Ctrl-C, after
+writing what was recorded). Errors are one line on stderr,
 ``ballcage: error: <message>``, never a traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import shlex
 import sys
+import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn, TypeAlias
@@ -38,6 +43,9 @@ TABLE_NAMES: tuple[str, ...] = tuple(_native.TABLE_NAMES)
 STABILITY_PARAMETERS: tuple[str, ...] = ("stiffness", "speed", "curvature_radius", "key_mass", "damping")
 #: What `ballcage run` names the embedded scene in messages.
 DEFAULT_SCENE_NAME = "default scene"
+#: The engineering tables `ballcage run` adds to what a drill-pipe scene records when neither the
+#: scene file nor ``--set`` chooses ``record.tables`` (``--tables`` chooses exactly).
+DRILL_PIPE_TABLES: tuple[str, ...] = ("links", "hinges", "keys", "drive", "summary", "pairs")
 
 
 class UsageError(Exception):
@@ -100,6 +108,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_stability_command(commands)
     _add_scene_command(commands)
     _add_schema_command(commands)
+    _add_buckling_command(commands)
     return parser
 
 
@@ -111,7 +120,12 @@ def _add_run_command(commands: _Commands) -> None:
     run = commands.add_parser(
         "run",
         help="simulate a scene and write Parquet tables",
-        description="Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml.",
+        description=(
+            "Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml. "
+            "The tables are the scene's record.tables; a drill-pipe scene that does not set record.tables "
+            f"(the embedded one, or a file without it) also records {', '.join(DRILL_PIPE_TABLES)}. "
+            "--tables chooses the tables instead."
+        ),
     )
     run.add_argument(
         "scene",
@@ -124,6 +138,15 @@ def _add_run_command(commands: _Commands) -> None:
         "--overwrite",
         action="store_true",
         help="replace an earlier run's tables in --out (without it, a folder holding them is refused)",
+    )
+    run.add_argument(
+        "--tables",
+        metavar="NAME,...",
+        help=(
+            f"tables to record, e.g. --tables links,drive (known: {', '.join(TABLE_NAMES)}; `ballcage schema` "
+            "describes them); default: the scene's record.tables, for a drill-pipe scene that does not set it "
+            f"also {','.join(DRILL_PIPE_TABLES)}"
+        ),
     )
     _add_set_option(run)
     _add_quiet_option(run, "no progress bar and no summary")
@@ -203,8 +226,8 @@ def _add_stability_command(commands: _Commands) -> None:
             "For each integrator, find the largest step at which a short probe run finishes without a divergence "
             "error (bracketing by factors of 4, then bisection in log dt), varying one parameter at a time around "
             "the defaults: contact stiffness of the key and cage contacts (1e3-1e7 N/mm^2.2), drive speed "
-            "(30-600 rpm), curvature radius (from the tightest the hinge allows, pitch / (2 sin(stop / 2)) = "
-            "0.766 m for the paper's pipe, to 5 m), key mass (1/4-4x) and contact damping (0 and 0.1-100 N s/mm). "
+            "(30-600 rpm), curvature radius (from the tightest the hinge allows, pitch / (2 sin(limit / 2)) = "
+            "0.770 m for the paper's pipe, to 5 m), key mass (1/4-4x) and contact damping (0 and 0.1-100 N s/mm). "
             "The probe scene is the paper's drill pipe with pipe.joints = 2, 0.03 s simulated and the drive and "
             "load ramped in over 0.01 s (--set and --duration change it). Writes stability.parquet, "
             "stability_<parameter>.png heat maps (integrator x value, colour log10 max stable dt) and stability.md."
@@ -239,15 +262,21 @@ def _add_stability_command(commands: _Commands) -> None:
 def _add_scene_command(commands: _Commands) -> None:
     scene = commands.add_parser(
         "scene",
-        help="the embedded default scene",
-        description="Work with the embedded default scene (the paper's drill pipe).",
+        help="show a scene (by default the embedded one) with every default and unit",
+        description="Work with scenes: the embedded default one (the paper's drill pipe) or a file.",
     )
     scene_commands = scene.add_subparsers(title="commands", required=True, metavar="COMMAND", parser_class=_Parser)
     show = scene_commands.add_parser(
         "show",
-        help="print the default scene as TOML",
-        description="Print the default scene as TOML, every default written out: copy it, edit it, run it.",
+        help="print a scene (default: the embedded one) as TOML, with units",
+        description=(
+            "Print a scene as TOML (without SCENE.toml, the embedded paper scene), every default written out "
+            "and each number's unit as a comment at the end of its line (contact laws in their own units, "
+            "e.g. N/mm^2.2): copy it, edit it, run it."
+        ),
     )
+    show.add_argument("scene", metavar="SCENE.toml", nargs="?", help="scene file (TOML); default: the embedded one")
+    _add_set_option(show)
     show.set_defaults(command=_scene_show)
 
 
@@ -259,6 +288,12 @@ def _add_schema_command(commands: _Commands) -> None:
     )
     schema.add_argument("table", nargs="?", choices=TABLE_NAMES, metavar="TABLE", help=f"one of {', '.join(TABLE_NAMES)}")
     schema.set_defaults(command=_schema)
+
+
+def _add_buckling_command(commands: _Commands) -> None:
+    from ballcage.buckling import add_command  # the command lives with its model (docs/buckling.md)
+
+    add_command(commands)
 
 
 def _add_out_option(parser: argparse.ArgumentParser) -> None:
@@ -307,8 +342,8 @@ def _load_cli_scene(arg: str | None, overrides: Sequence[str]) -> _native.Scene:
         if arg is None:
             return default_scene(overrides)
         return load_scene(arg, overrides)
-    except _native.SceneError as e:
-        raise UsageError(f"{arg or DEFAULT_SCENE_NAME}: {e}") from e
+    except _native.SceneError as e:  # `load_scene` names the file itself
+        raise UsageError(str(e) if arg is not None else f"{DEFAULT_SCENE_NAME}: {e}") from e
     except OSError as e:  # missing, a directory, unreadable
         raise UsageError(f"{e.strerror or e}: {e.filename or arg}") from e
     except UnicodeDecodeError as e:
@@ -330,7 +365,14 @@ def _run(args: argparse.Namespace) -> int:
             f"--out {out} holds another run's output ({', '.join(earlier)}); "
             "pass --overwrite to replace it, or choose another folder"
         )
+    chosen = _names("--tables", args.tables, TABLE_NAMES, "table")
     scene = _load_cli_scene(args.scene, overrides)
+    tables = _run_tables(scene, chosen, args.scene, overrides)
+    if tables is not None:
+        try:
+            scene = _load_cli_scene(args.scene, [*overrides, "record.tables=" + json.dumps(tables)])
+        except UsageError as e:  # the scene loaded without the tables: they are what it refuses
+            raise UsageError(f"--tables {','.join(tables)}: {e}") from e
     try:
         result = simulate(scene, progress=False if args.quiet else None)
     except (_native.SimulationError, KeyboardInterrupt) as e:
@@ -348,6 +390,36 @@ def _run(args: argparse.Namespace) -> int:
         for name, path in paths.items():
             print(_summary(name, path, result.tables.get(name)))
     return 0
+
+
+def _run_tables(
+    scene: _native.Scene, chosen: list[str] | None, path: str | None, overrides: Sequence[str]
+) -> list[str] | None:
+    """The tables `ballcage run` records when they are not the scene's own choice, else ``None``.
+
+    `chosen` (``--tables``) wins; a drill-pipe scene whose file and `overrides`
+    leave ``record.tables`` out records `DRILL_PIPE_TABLES` besides its own.
+    """
+    if chosen is not None:
+        return chosen
+    if scene.kind != "drill-pipe" or _sets_record_tables(path, overrides):
+        return None
+    return list(dict.fromkeys([*scene.table_names, *DRILL_PIPE_TABLES]))
+
+
+def _sets_record_tables(path: str | None, overrides: Sequence[str]) -> bool:
+    """Whether the scene file at `path` or an override sets ``record.tables`` (or the whole ``record``)."""
+    keys = [o.partition("=")[0].strip() for o in overrides]
+    if any(k == "record" or k.startswith("record.tables") for k in keys):
+        return True
+    if path is None:
+        return False
+    try:
+        document = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):  # the scene loaded: not expected
+        return False
+    record = document.get("record")
+    return isinstance(record, dict) and "tables" in record
 
 
 def _positive(option: str, text: str | None, what: str = "a positive time in seconds") -> float | None:
@@ -503,7 +575,8 @@ def _paper_summary(name: str, path: Path) -> str:
 
 
 def _scene_show(args: argparse.Namespace) -> int:
-    text = _native.default_scene_toml()
+    overrides = [_checked_override(o) for o in args.overrides]
+    text = _load_cli_scene(args.scene, overrides).to_toml(units=True)
     sys.stdout.write(text if text.endswith("\n") else text + "\n")
     return 0
 

@@ -198,7 +198,9 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
     parsed as TOML).
 
     Raises `ballcage.SceneError` (naming the field) for an invalid scene and
-    `FileNotFoundError` (naming the path) for a missing file.
+    `FileNotFoundError` (naming the path) for a missing file. The message of
+    an error in a file starts with the file's path: ``bad.toml: TOML syntax
+    error at line 2, column 7: …`` or ``bad.toml: scene field `…` = …: …``.
     """
     if isinstance(overrides, str):
         raise TypeError("overrides is a list of 'key=value' strings, not one string")
@@ -210,7 +212,11 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
     if isinstance(source, Mapping):
         return _native.Scene.from_dict(_plain(source), patches)
     if isinstance(source, (str, os.PathLike)):
-        return _native.Scene.from_toml(_read_scene_file(source), patches)
+        text = _read_scene_file(source)
+        try:
+            return _native.Scene.from_toml(text, patches)
+        except _native.SceneError as e:
+            raise _in_file(e, source) from None
     raise TypeError(
         f"cannot load a scene from {type(source).__name__}: give a path to a TOML file, "
         "a dict, a SceneBuilder or a ballcage.Scene"
@@ -242,6 +248,14 @@ def _read_scene_file(source: str | os.PathLike[str]) -> str:
         return path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise FileNotFoundError(errno.ENOENT, "scene file not found", str(path)) from None
+
+
+def _in_file(error: _native.SceneError, source: str | os.PathLike[str]) -> _native.SceneError:
+    """`error` with the scene file's path in front of its message; ``path``, ``value`` and ``reason`` kept."""
+    named = _native.SceneError(f"{os.fspath(source)}: {error}")
+    for attribute in ("path", "value", "reason"):
+        setattr(named, attribute, getattr(error, attribute, ""))
+    return named
 
 
 def _plain(value: Any) -> Any:

@@ -9,7 +9,7 @@
 //!    for `spin` bodies.
 
 use crate::force::friction_force;
-use crate::force::joint::{bend, twist_axis};
+use crate::force::joint::twist_axis;
 use crate::geometry::ContactPoint;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
@@ -370,7 +370,7 @@ impl Dynamics {
     /// respect to the velocities when the positions move with them as
     /// x = x₀ + s·v (an implicit stage of weight s). K holds the normal
     /// stiffness of each contact point (∂F_n/∂δ along the normal, with the
-    /// friction it carries) and the joint springs and bend stop; the
+    /// friction it carries) and the joint springs; the
     /// geometric terms (normals and lever arms turning with the bodies) are
     /// left out, which Newton iterations tolerate.
     pub fn forces_and_jacobian(
@@ -697,8 +697,7 @@ impl VelocityJacobian {
     /// (arms `ra`, `rb`) and −c_t·(ê·(ω_b − ω_a))·ê on b about the mean x
     /// axis ê ([`twist_axis`]).
     ///
-    /// With a stiffness scale s the springs add s·k in the same places, and
-    /// an engaged bend stop −s·k_stop·uuᵀ about its axis u.
+    /// With a stiffness scale s the springs add s·k in the same places.
     fn add_joint(&mut self, k: usize, j: &Joint, state: &State, ra: &Vec3, rb: &Vec3) {
         let p = &j.params;
         let s = self.stiffness_scale;
@@ -706,22 +705,10 @@ impl VelocityJacobian {
         if linear != 0.0 {
             self.add_gradient(k, &(-linear * Mat3::identity()), ra, rb);
         }
-        let mut rotational = Mat3::zeros();
         let twist = p.twist_damping + s * p.twist_stiffness;
         if twist != 0.0 {
             let axis = twist_axis(&state.rot[j.a], &state.rot[j.b]);
-            rotational += twist * axis * axis.transpose();
-        }
-        if s > 0.0 && p.stop_stiffness != 0.0 {
-            let (bend, opening) = bend(&state.rot[j.a], &state.rot[j.b]);
-            if bend > p.bend_limit
-                && let Some(u) = opening
-            {
-                rotational += s * p.stop_stiffness * u * u.transpose();
-            }
-        }
-        if rotational != Mat3::zeros() {
-            let t = rotational;
+            let t = twist * axis * axis.transpose();
             let c = &mut self.couplings[k];
             c.active = true;
             let add = |m: &mut Mat6, sign: f64| {

@@ -6,9 +6,10 @@ use thiserror::Error;
 ///
 /// `path` is the dotted location of the offending value in the scene
 /// (`bodies[1].mass`), `value` the value as written (empty if missing) and
-/// `reason` what is wrong with it.
+/// `reason` what is wrong with it. An error of the document as a whole (a
+/// TOML syntax error) has an empty path and displays its reason alone.
 #[derive(Debug, Clone, Error, PartialEq)]
-#[error("scene field `{path}`{}: {reason}", if value.is_empty() { String::new() } else { format!(" = {value}") })]
+#[error("{}{reason}", if path.is_empty() { String::new() } else if value.is_empty() { format!("scene field `{path}`: ") } else { format!("scene field `{path}` = {value}: ") })]
 pub struct SceneError {
     /// Dotted path of the offending field, e.g. `contacts[0].normal.stiffness`.
     pub path: String,

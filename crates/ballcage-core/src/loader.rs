@@ -11,13 +11,15 @@
 //! Loading validates, expands and assembles once: a [`Document`] holds the
 //! assembled model, and every simulation of it starts from a copy.
 
+use std::collections::HashMap;
+
 use crate::assembly::{assemble, assemble_validated};
 use crate::drillpipe::{self, DrillPipeSpec, Layout, PipeTables};
 use crate::error::SceneError;
 use crate::model::{Model, State};
 use crate::record::{Observer, TableDef, table_def};
 use crate::scene::{
-    Scene, TableKind, apply_override, deserialize_with_path, lookup, merge, parse_toml,
+    FieldUnits, Scene, TableKind, apply_override, deserialize_with_path, lookup, merge, parse_toml,
 };
 use crate::sim::Simulation;
 
@@ -197,6 +199,14 @@ impl Document {
         }
     }
 
+    /// The document as [`Self::to_toml`] writes it, with the unit of every
+    /// number as a comment at the end of its line (`pitch = 0.2  # m`; a
+    /// law's fields in its own `units`, e.g. `# N/mm^2.2`); see
+    /// [`field_unit`]. The text parses to the same values.
+    pub fn to_toml_with_units(&self) -> String {
+        with_units(&self.to_toml(), &self.source_value())
+    }
+
     /// The resolved value at a dotted key (the syntax of overrides); the
     /// empty key gives the whole document.
     pub fn value(&self, key: &str) -> Result<toml::Value, SceneError> {
@@ -257,6 +267,166 @@ pub fn table(name: &str) -> Option<&'static TableDef> {
     tables().into_iter().find(|t| t.name == name)
 }
 
+/// `text`, TOML as [`Document::to_toml`] writes it (table headers and
+/// `key = value` lines at the start of a line, arrays over several lines),
+/// with `  # unit` after each line that sets a number or an array of
+/// numbers whose unit [`field_unit`] knows; `root` is the parsed document.
+fn with_units(text: &str, root: &toml::Value) -> String {
+    let mut section: Option<&toml::Table> = root.as_table();
+    let mut section_name = String::new();
+    // Elements seen so far of each array of tables (`[[bodies]]`), by its dotted name.
+    let mut seen: HashMap<String, usize> = HashMap::new();
+    let mut out = String::with_capacity(text.len() + text.len() / 4);
+    for line in text.lines() {
+        out.push_str(line);
+        if let Some(header) = line.strip_prefix('[') {
+            section_name = header.trim_matches(|c| c == '[' || c == ']').to_string();
+            if header.starts_with('[') {
+                *seen.entry(section_name.clone()).or_default() += 1;
+            }
+            section = table_at(root, &section_name, &seen);
+        } else if let Some((key, _)) = line.split_once(" = ")
+            && !line.starts_with(' ')
+            && let Some(table) = section
+            && table.get(key).is_some_and(is_numeric)
+            && let Some(unit) = field_unit(&section_name, key, table)
+        {
+            out.push_str("  # ");
+            out.push_str(&unit);
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// The table at the dotted header `name` of `root`; in an array of tables,
+/// the element `seen` counts up to (its last one so far).
+fn table_at<'a>(
+    root: &'a toml::Value,
+    name: &str,
+    seen: &HashMap<String, usize>,
+) -> Option<&'a toml::Table> {
+    let mut v = root;
+    let mut prefix = String::new();
+    for seg in name.split('.').filter(|s| !s.is_empty()) {
+        if !prefix.is_empty() {
+            prefix.push('.');
+        }
+        prefix.push_str(seg);
+        v = v.get(seg)?;
+        if let toml::Value::Array(items) = v {
+            v = items.get(seen.get(&prefix)?.checked_sub(1)?)?;
+        }
+    }
+    v.as_table()
+}
+
+/// A number, or a non-empty array of numbers.
+fn is_numeric(v: &toml::Value) -> bool {
+    match v {
+        toml::Value::Integer(_) | toml::Value::Float(_) => true,
+        toml::Value::Array(a) => !a.is_empty() && a.iter().all(is_numeric),
+        _ => false,
+    }
+}
+
+/// The unit of the number `key` in the table `table` at the dotted
+/// `section` of a scene document of any kind (`"-"` for a pure number),
+/// or `None` when it is not known. Scene fields are SI (the drill pipe's
+/// `_deg` and `_rpm` fields say their unit in their name); a contact law's
+/// fields are in its `units` ([`FieldUnits`]), its stiffness in N/m^n (or
+/// N/mm^n) for its exponent n.
+pub fn field_unit(section: &str, key: &str, table: &toml::Table) -> Option<String> {
+    if let Some(law) = table.get("law").and_then(toml::Value::as_str) {
+        return law_field_unit(law, key, table);
+    }
+    let exact = match (section.rsplit('.').next().unwrap_or(""), key) {
+        ("world", "gravity") => Some("m/s²"),
+        ("newton", _) | ("divergence", "penetration_fraction" | "energy_growth") => Some("-"),
+        ("record", "summary_window") => Some("s"),
+        _ => None,
+    };
+    exact.or_else(|| named_unit(key)).map(str::to_string)
+}
+
+/// The unit a field's name implies (see [`field_unit`]).
+fn named_unit(key: &str) -> Option<&'static str> {
+    const BY_NAME: &[(&[&str], &str)] = &[
+        (
+            &["duration", "dt", "output_interval", "ramp", "spin_ramp"],
+            "s",
+        ),
+        (&["joints", "tube_contact_points", "points"], "-"),
+        (&["twist_stiffness", "stop_stiffness"], "N·m/rad"),
+        (&["twist_damping"], "N·m·s/rad"),
+        (&["stiffness"], "N/m"),
+        (&["damping"], "N·s/m"),
+        (&["resisting_moment", "magnitude"], "N·m"),
+        (&["velocity"], "m/s"),
+        (&["angular_velocity", "spin_speed"], "rad/s"),
+        (&["density"], "kg/m³"),
+        (&["orientation", "normal", "axis", "spin_axis"], "-"),
+        (
+            &["position", "pitch", "max_penetration", "half_extents"],
+            "m",
+        ),
+    ];
+    const BY_SUFFIX: &[(&str, &str)] = &[
+        ("_deg", "deg"),
+        ("_rpm", "rpm"),
+        ("mass", "kg"),
+        ("inertia", "kg·m²"),
+        ("radius", "m"),
+        ("diameter", "m"),
+        ("length", "m"),
+        ("width", "m"),
+        ("offset", "m"),
+        ("clearance", "m"),
+    ];
+    BY_NAME
+        .iter()
+        .find(|(names, _)| names.contains(&key))
+        .map(|(_, unit)| *unit)
+        .or_else(|| {
+            BY_SUFFIX
+                .iter()
+                .find(|(suffix, _)| key.ends_with(suffix))
+                .map(|(_, unit)| *unit)
+        })
+}
+
+/// The unit of field `key` of a contact law table `table` whose `law` is `law`.
+fn law_field_unit(law: &str, key: &str, table: &toml::Table) -> Option<String> {
+    let units: FieldUnits = table
+        .get("units")
+        .and_then(|u| u.clone().try_into().ok())
+        .unwrap_or_default();
+    let length = match units {
+        FieldUnits::Si => "m",
+        FieldUnits::NMmS => "mm",
+    };
+    let unit = match key {
+        "stiffness" => {
+            let n = match (law, table.get("exponent")) {
+                (_, Some(n)) => n.as_float().or_else(|| n.as_integer().map(|i| i as f64))?,
+                ("hertz", None) => 1.5,
+                _ => 1.0,
+            };
+            if n == 1.0 {
+                format!("N/{length}")
+            } else {
+                format!("N/{length}^{n}")
+            }
+        }
+        "damping" => format!("N·s/{length}"),
+        "depth_max" => length.to_string(),
+        "v_static" | "v_dynamic" | "v_ref" | "min_approach_speed" => format!("{length}/s"),
+        "exponent" | "restitution" | "mu" | "mu_static" | "mu_dynamic" => "-".to_string(),
+        _ => return None,
+    };
+    Some(unit)
+}
+
 /// The embedded default document: the paper's drill pipe.
 pub fn default_document() -> DrillPipeSpec {
     DrillPipeSpec::default()
@@ -290,6 +460,96 @@ mod tests {
         }
         assert_eq!(table("links").map(|t| t.name), Some("links"));
         assert!(table("nonsense").is_none());
+    }
+
+    #[test]
+    fn a_toml_syntax_error_names_its_line_and_column_and_no_field() {
+        let e = parse_toml("[pipe]\njoints = @\n").unwrap_err();
+        assert_eq!(e.path, "");
+        let expected = "TOML syntax error at line 2, column 10: ";
+        assert!(e.reason.starts_with(expected), "{e:?}");
+        // Columns count characters, not bytes: `@` is the 10th character, the 12th byte.
+        let e = parse_toml("a = 1\nb = \"µµ\" @\n").unwrap_err();
+        assert!(e.reason.contains("at line 2, column 10: "), "{e:?}");
+    }
+
+    /// Every number of the default drill-pipe document, under either hinge
+    /// model, with a unit comment; the annotated text reads back the same.
+    #[test]
+    fn every_number_of_a_drill_pipe_document_has_a_unit() {
+        for hinge in ["ball-keys", "ideal-cv"] {
+            let overrides = [format!("pipe.hinge=\"{hinge}\"")];
+            let doc = Document::from_toml_str("kind = \"drill-pipe\"", &overrides).unwrap();
+            let text = doc.to_toml_with_units();
+            let lines: Vec<&str> = text.lines().collect();
+            let number = |v: &str| v.starts_with(|c: char| c.is_ascii_digit() || c == '-');
+            let mut numeric_lines = 0;
+            for (i, line) in lines.iter().enumerate() {
+                let Some((_, value)) = line.split_once(" = ").filter(|_| !line.starts_with(' '))
+                else {
+                    continue;
+                };
+                let value = value.split("  # ").next().unwrap_or("");
+                let next = lines.get(i + 1).map_or("", |l| l.trim());
+                if number(value) || (value == "[" && number(next)) {
+                    numeric_lines += 1;
+                    assert!(line.contains("  # "), "{hinge}: no unit on `{line}`");
+                }
+            }
+            assert!(numeric_lines > 50, "{numeric_lines} numeric lines");
+            assert!(text.contains("curvature_radius = 1.5  # m\n"), "{text}");
+            assert!(text.contains("speed_rpm = 100.0  # rpm\n"), "{text}");
+            assert!(text.contains("link_inertia = [  # kg·m²\n"), "{text}");
+            assert!(
+                text.contains("stiffness = 100000.0  # N/mm^2.2\n"),
+                "{text}"
+            );
+            assert!(text.contains("damping = 10.0  # N·s/mm\n"), "{text}");
+            assert!(text.contains("v_static = 100.0  # mm/s\n"), "{text}");
+            assert!(text.contains("stiffness = 1000000000.0  # N/m\n"), "{text}");
+            assert!(!text.contains("tables = [  #"), "{text}");
+            let back: toml::Table = text.parse().unwrap();
+            assert_eq!(toml::Value::Table(back), doc.source_value());
+        }
+    }
+
+    #[test]
+    fn each_element_of_an_array_of_tables_gets_its_own_units() {
+        let text = "[simulation]\nduration = 0.1\ndt = 1e-4\noutput_interval = 1e-3\n\
+                    [[bodies]]\nname = \"ground\"\nmotion = \"fixed\"\n\
+                    shape = { type = \"half-space\", normal = [0.0, 0.0, 1.0] }\n\
+                    [[bodies]]\nname = \"ball\"\nmass = 1.0\nshape = { type = \"ball\", radius = 0.05 }\n\
+                    [[contacts]]\nbodies = [\"ground\", \"ball\"]\n\
+                    normal = { law = \"hertz\", stiffness = 1e8 }\n";
+        let annotated = Document::from_toml_str(text, &[])
+            .unwrap()
+            .to_toml_with_units();
+        for expected in [
+            "normal = [  # -\n",
+            "radius = 0.05  # m\n",
+            "mass = 1.0  # kg\n",
+            "stiffness = 100000000.0  # N/m^1.5\n",
+        ] {
+            assert!(annotated.contains(expected), "{expected} in {annotated}");
+        }
+    }
+
+    #[test]
+    fn law_units_follow_the_law_and_its_field_units() {
+        let law = |text: &str| text.parse::<toml::Table>().unwrap();
+        let si = law("law = \"hertz\"\nstiffness = 1e8");
+        assert_eq!(
+            field_unit("contacts.normal", "stiffness", &si).unwrap(),
+            "N/m^1.5"
+        );
+        let lin = law("law = \"linear\"\nstiffness = 1e5\ndamping = 1\nunits = \"N-mm-s\"");
+        assert_eq!(field_unit("x", "stiffness", &lin).unwrap(), "N/mm");
+        assert_eq!(field_unit("x", "damping", &lin).unwrap(), "N·s/mm");
+        let none = toml::Table::new();
+        assert_eq!(field_unit("world", "gravity", &none).unwrap(), "m/s²");
+        assert_eq!(field_unit("bodies", "mass", &none).unwrap(), "kg");
+        assert_eq!(field_unit("pipe", "neck_radius", &none).unwrap(), "m");
+        assert_eq!(field_unit("bodies", "whatever", &none), None);
     }
 
     #[test]

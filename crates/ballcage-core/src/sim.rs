@@ -28,6 +28,11 @@ pub struct Simulation {
     balance: EnergyBalance,
     /// The contact watch of the last accepted step (stable-step estimate).
     last_watch: ContactWatch,
+    /// Halvings of SDIRK2 steps before the current step (divergence advice).
+    halvings_before_step: u64,
+    /// The deepest penetration at t = 0 relative to its pair's limit:
+    /// (pair, depth [m], depth / limit) (divergence advice).
+    initial_deepest: Option<(usize, f64, f64)>,
 }
 
 /// What stopped a run, for the advice in its error.
@@ -79,6 +84,7 @@ impl Simulation {
         let workspace = Workspace::new(&state);
         let mut recorder = Recorder::new(&model, observers);
         recorder.record(&model, &state, 0, &mut dynamics);
+        let initial_deepest = deepest_penetration(&model, &state, &mut dynamics);
         let e0 = dynamics.energy(&model, &state);
         let balance = EnergyBalance {
             initial: e0.total(),
@@ -98,6 +104,8 @@ impl Simulation {
             failed: None,
             balance,
             last_watch: ContactWatch::default(),
+            halvings_before_step: 0,
+            initial_deepest,
         }
     }
 
@@ -175,13 +183,17 @@ impl Simulation {
     /// created beyond the divergence tolerance (checked at recorded frames),
     /// or an implicit step that cannot be solved. The error names the time,
     /// the bodies or pair, and the step the stability estimate says would
-    /// hold; the frames recorded so far stay available to [`Self::finish`].
+    /// hold, or, when a smaller step would probably not help (an initial
+    /// overlap, a step already retried in halves, a step already within the
+    /// estimate), what to check instead; the frames recorded so far stay
+    /// available to [`Self::finish`].
     pub fn step(&mut self) -> Result<(), SimulationError> {
         if let Some(e) = &self.failed {
             return Err(e.clone());
         }
         let h = self.model.dt;
         self.dynamics.watch.reset();
+        self.halvings_before_step = self.workspace.stats().halvings;
         if let Err(reason) = integrate::step(
             &self.model,
             &mut self.dynamics,
@@ -307,67 +319,118 @@ impl Simulation {
         Err(e)
     }
 
-    /// What the stability estimate of the last accepted step says about dt.
+    /// What to change after a failure: the step the stability estimate of
+    /// the last accepted step asks for, or, when the step is probably not
+    /// the cause (see [`Self::not_the_step`]), what to check instead.
     fn step_advice(&self, failure: Failure) -> String {
-        let w = if self.last_watch.saw_contact() {
-            self.last_watch
-        } else {
-            self.dynamics.watch
-        };
         let kind = self.model.integrator;
         let dt = self.model.dt;
-        let (estimate, pair) = match kind {
-            IntegratorKind::SymplecticEuler => w.explicit_step(),
-            // RK4's stability interval on the real and imaginary axes is
-            // about 2.8 against symplectic Euler's 2.
-            IntegratorKind::Rk4 => {
-                let (h, pair) = w.explicit_step();
-                (1.4 * h, pair)
-            }
-            IntegratorKind::LinearlyImplicitEuler => w.elastic_step(),
-            // No stability limit on the linearized contacts: resolve the
-            // stiffest contact's period instead.
-            IntegratorKind::Sdirk2 => {
-                let (period, pair) = w.period();
-                (period / 10.0, pair)
-            }
-        };
-        let Some(p) = self.model.pairs.get(pair).filter(|_| estimate.is_finite()) else {
+        let (estimate, pair, what) = self.stable_step();
+        let stiffest = self.model.pairs.get(pair).filter(|_| estimate.is_finite());
+        if let Some((why, names_a_pair)) = self.not_the_step(estimate, stiffest.is_some()) {
+            let at = stiffest
+                .filter(|_| !names_a_pair)
+                .map_or(String::new(), |p| {
+                    format!(
+                        "; the stiffest contact was pair `{}` (bodies `{}` and `{}`)",
+                        p.name, self.model.bodies[p.a].name, self.model.bodies[p.b].name
+                    )
+                });
             return format!(
-                "no contact was active, so there is no stable-step estimate; \
-                 try simulation.dt = {:.3e} s",
-                dt / 4.0
+                "{why}, so the step ({dt:.3e} s with {}) is probably not the cause: {}{at}",
+                kind.name(),
+                what_to_check(failure)
+            );
+        }
+        let Some(p) = stiffest else {
+            return format!(
+                "no contact was active, so there is no stable-step estimate; try \
+                 simulation.dt = {:.3e} s, and if the run fails at the same time \
+                 again, the step is not the cause: {}",
+                dt / 4.0,
+                what_to_check(failure)
             );
         };
-        let what = if kind == IntegratorKind::Sdirk2 {
-            "a tenth of the stiffest contact's period"
-        } else {
-            "the stability estimate of the stiffest contact"
-        };
-        let advice = if estimate < dt {
-            format!("{what} asks for simulation.dt ≤ {estimate:.3e} s")
-        } else if failure == Failure::Penetration {
-            format!(
-                "{what} ({estimate:.3e} s) is above the step, so the penetration may be \
-                 physical (a contact too soft for its load): if it is, raise \
-                 simulation.divergence.penetration_fraction or set max_penetration; \
-                 otherwise try simulation.dt = {:.3e} s",
-                dt / 4.0
-            )
-        } else {
-            format!(
-                "{what} ({estimate:.3e} s) is above the step, so the instability is \
-                 elsewhere (joints, gyroscopic terms); try simulation.dt = {:.3e} s",
-                dt / 4.0
-            )
-        };
         format!(
-            "{advice} with {} (pair `{}`, bodies `{}` and `{}`; the step is {dt:.3e} s)",
+            "{what} asks for simulation.dt ≤ {estimate:.3e} s with {} (pair `{}`, bodies \
+             `{}` and `{}`; the step is {dt:.3e} s)",
             kind.name(),
             p.name,
             self.model.bodies[p.a].name,
             self.model.bodies[p.b].name
         )
+    }
+
+    /// The stable step the contact watch of the last accepted step gives
+    /// for the integrator [s] (infinite without a contact), the pair that
+    /// sets it, and what the estimate is, in words.
+    fn stable_step(&self) -> (f64, usize, &'static str) {
+        let w = if self.last_watch.saw_contact() {
+            self.last_watch
+        } else {
+            self.dynamics.watch
+        };
+        let explicit = "the stability estimate of the stiffest contact";
+        match self.model.integrator {
+            IntegratorKind::SymplecticEuler => {
+                let (h, pair) = w.explicit_step();
+                (h, pair, explicit)
+            }
+            // RK4's stability interval on the real and imaginary axes is
+            // about 2.8 against symplectic Euler's 2.
+            IntegratorKind::Rk4 => {
+                let (h, pair) = w.explicit_step();
+                (1.4 * h, pair, explicit)
+            }
+            IntegratorKind::LinearlyImplicitEuler => {
+                let (h, pair) = w.elastic_step();
+                (h, pair, explicit)
+            }
+            // No stability limit on the linearized contacts: resolve the
+            // stiffest contact's period instead.
+            IntegratorKind::Sdirk2 => {
+                let (period, pair) = w.period();
+                (
+                    period / 10.0,
+                    pair,
+                    "a tenth of the stiffest contact's period",
+                )
+            }
+        }
+    }
+
+    /// Why a smaller step would probably not cure the failure, if it would
+    /// not: a pair already penetrated beyond its limit at t = 0; the
+    /// failing step was already retried in halves (SDIRK2); or the step is
+    /// already within the stability estimate `estimate` [s] (`estimated`:
+    /// a contact gave one). The flag says whether the reason names a pair.
+    fn not_the_step(&self, estimate: f64, estimated: bool) -> Option<(String, bool)> {
+        if let Some((k, depth, ratio)) = self.initial_deepest.filter(|d| d.2 > 1.0) {
+            let p = &self.model.pairs[k];
+            let why = format!(
+                "pair `{}` already penetrates {:.4} mm at t = 0, {ratio:.1} times its limit of \
+                 {:.4} mm (an initial overlap)",
+                p.name,
+                depth * 1e3,
+                p.depth_limit * 1e3
+            );
+            return Some((why, true));
+        }
+        let halvings = self.workspace.stats().halvings - self.halvings_before_step;
+        if halvings > 0 {
+            let why = format!(
+                "the failing step was already retried in halves ({halvings} times) without \
+                 curing it"
+            );
+            return Some((why, false));
+        }
+        let (dt, what) = (self.model.dt, self.stable_step().2);
+        (estimated && estimate >= dt).then(|| {
+            (
+                format!("the step is already within {what} ({estimate:.3e} s)"),
+                false,
+            )
+        })
     }
 
     fn non_finite(&self) -> Option<String> {
@@ -455,4 +518,45 @@ impl Simulation {
             )
         })
     }
+}
+
+/// What to check when the step is not the cause of a failure.
+fn what_to_check(failure: Failure) -> &'static str {
+    match failure {
+        Failure::Penetration => {
+            "the penetration may be physical or set up; check that the pair's geometry \
+             fits (parts that do not fit, an initial overlap), that its contact law is \
+             not too soft for the load (raise its stiffness, or \
+             simulation.divergence.penetration_fraction / max_penetration if the depth is \
+             real) nor too stiff, and that no load (drive, moment, gravity) is too large"
+        }
+        Failure::Numerical => {
+            "check for an initial overlap or geometry that does not fit (a penetration \
+             beyond a pair's limit), a contact law too stiff or too soft, a load (drive, \
+             moment, gravity) too large, the joints' stiffness, and for SDIRK2 \
+             simulation.newton.max_iterations"
+        }
+    }
+}
+
+/// The deepest penetration of any pair at `state` relative to its pair's
+/// limit: (pair, depth [m], depth / limit), `None` without contact.
+fn deepest_penetration(
+    model: &Model,
+    state: &State,
+    dynamics: &mut Dynamics,
+) -> Option<(usize, f64, f64)> {
+    let mut points = Vec::new();
+    let mut deepest: Option<(usize, f64, f64)> = None;
+    for (k, pair) in model.pairs.iter().enumerate() {
+        points.clear();
+        dynamics.contact_points(model, state, k, &mut points);
+        for e in &points {
+            let ratio = e.point.depth / pair.depth_limit;
+            if ratio > deepest.map_or(0.0, |d| d.2) {
+                deepest = Some((k, e.point.depth, ratio));
+            }
+        }
+    }
+    deepest
 }

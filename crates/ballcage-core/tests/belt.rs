@@ -64,8 +64,6 @@ fn belt(v_belt: f64, x0: f64, duration: f64) -> Simulation {
         damping = 0.0
         twist_stiffness = 1e-3
         twist_damping = 0.0
-        bend_limit_deg = 90.0
-        stop_stiffness = 1e-3
         "#
     ))
 }

@@ -163,8 +163,6 @@ fn energy_created_without_contact_stops_the_run() {
         damping = 0.0
         twist_stiffness = 1.0
         twist_damping = 0.0
-        bend_limit_deg = 90.0
-        stop_stiffness = 1.0
         "#,
     );
     let e = sim.run().unwrap_err();

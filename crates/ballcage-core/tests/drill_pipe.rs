@@ -79,8 +79,9 @@ fn the_paper_scene_expands_to_its_bodies_and_pairs_and_starts_without_contact() 
     let scene = doc.scene();
     // 1 tube + 2 connectors + 12 links + 13 cages + 78 keys.
     assert_eq!(scene.bodies.len(), 106);
-    // 12 link–tube pairs; per hinge 2 cage spheres + 6 keys × (2 + 2 flanks + 2 window pairs).
-    assert_eq!(scene.contacts.len(), 12 + 13 * (2 + 6 * 6));
+    // 12 link–tube pairs; per hinge 2 cage spheres + the neck–mouth pair
+    // + 6 keys × (2 + 2 flanks + 2 window pairs).
+    assert_eq!(scene.contacts.len(), 12 + 13 * (3 + 6 * 6));
     let mut sim = doc.simulation();
     for k in 0..scene.contacts.len() {
         assert!(
@@ -127,6 +128,15 @@ fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
     );
     let (spec, _) = doc.drill_pipe_parts().unwrap();
     assert_eq!(spec.borehole.curvature_radius, 2.5);
+    // The name follows the scene, and says the paper's only when it is.
+    assert_eq!(scene.name, "4 ball-cage joints, R 2.5 m, 60 rpm, 0.9 kN·m");
+    let paper = Document::from_toml_str("kind = \"drill-pipe\"\n", &[]).unwrap();
+    assert_eq!(
+        paper.scene().name,
+        "Zhu et al. 2023: 12 ball-cage joints, R 1.5 m, 100 rpm, 1.8 kN·m"
+    );
+    let cv = Document::from_toml_str("kind = \"drill-pipe\"\n", &o(&["pipe.hinge=\"ideal-cv\""]));
+    assert!(cv.unwrap().scene().name.starts_with("12 ideal-CV joints"));
     let upper = scene.bodies.iter().find(|b| b.name == "upper").unwrap();
     assert!(
         (upper.spin_speed - 2.0 * std::f64::consts::PI).abs() < 1e-12,
@@ -150,8 +160,9 @@ fn dotted_keys_of_the_drill_pipe_scene_take_effect() {
 /// |C_head − C_seat| = 2(a + s + δ). So cos α′ = a·cos α/(a + s + δ) and
 /// T = 6·K·δⁿ·PCR·sin α′. Returns (per-key force [N], wind-up per hinge [rad]).
 /// With s = 0 and δ ≪ a this is docs/model.md §7.9: T/(6·PCR·sin 45°) = 13.47 kN.
-fn section_model(torque: f64, k: f64, n: f64, s: f64) -> (f64, f64) {
-    let (pcr, alpha, rho_g, r_b) = (0.0315, std::f64::consts::FRAC_PI_4, 0.0078, 0.0075);
+/// `rho_g` is the Gothic arch's flank radius [m] (a = ρ_g − r_b − s).
+fn section_model(torque: f64, k: f64, n: f64, s: f64, rho_g: f64) -> (f64, f64) {
+    let (pcr, alpha, r_b) = (0.0315, std::f64::consts::FRAC_PI_4, 0.0075);
     let a = rho_g - r_b - s;
     let t_of =
         |d: f64| 6.0 * k * d.powf(n) * pcr * (1.0 - (a * alpha.cos() / (a + s + d)).powi(2)).sqrt();
@@ -244,15 +255,15 @@ fn quasi_static_hinges(extra: &[&str]) -> (PerKey, f64, PerKey) {
 #[test]
 fn one_hinge_under_quasi_static_torque_carries_13_47_kn_per_key() {
     // docs/model.md §7.9's assumptions: no flank clearance, contacts stiff enough
-    // that the 45° contact angle holds (K = 1e12 N/mm^2.2: δ ≈ 0.3 µm ≪ a = 0.3 mm).
+    // that the 45° contact angle holds (K = 1e12 N/mm^2.2: δ ≈ 0.3 µm ≪ a = 7.5 mm).
     let (forces, _, angles) = quasi_static_hinges(&[
         "pipe.ball_keys.flank_clearance=0",
         "materials.internal.normal.stiffness=1e12",
     ]);
-    // δ ≈ 0.3 µm against a = 0.3 mm: the contact angle holds its 45° (the
-    // section model: acos(a cos 45° / (a + δ)) = 45.06°; the full model's ball
-    // also shifts in its groove under the cage's push, measured 0.9°), far
-    // from the ~72° it opens to under the paper's law (next test).
+    // δ ≈ 0.3 µm against a = 7.5 mm: the contact angle holds its 45° (the
+    // section model: acos(a cos 45° / (a + δ)) = 45.002°; the full model's ball
+    // also shifts in its groove under the cage's push), far from the ~72° a
+    // close groove opens to under the paper's law (next test).
     for (i, (inner, outer)) in angles.iter().enumerate() {
         for a in [inner, outer] {
             assert!((a - 45.0).abs() < 1.5, "key {i}: contact angle {a}°");
@@ -278,13 +289,13 @@ fn one_hinge_under_quasi_static_torque_carries_13_47_kn_per_key() {
 }
 
 #[test]
-fn with_the_paper_law_the_contact_angle_opens_and_keys_carry_less() {
+fn with_the_paper_law_a_close_groove_opens_its_contact_angle_and_keys_carry_less() {
     // The paper's law is soft: at ~10 kN a key penetrates ~0.35 mm, more than the
-    // 0.29 mm flank offset of the proposed Gothic arch, so the contact angle opens
-    // from 45° toward 72° and each key carries ~10 kN, not 13.47 kN.
+    // 0.29 mm flank offset of a close Gothic arch (ρ_g = 7.8 mm, f = 1.04), so the
+    // contact angle opens from 45° toward 72° and each key carries ~10 kN, not 13.47 kN.
     let k = 1e5 * 1000f64.powf(2.2);
-    let (forces, turned, angles) = quasi_static_hinges(&[]);
-    let (model, per_hinge) = section_model(1800.0, k, 2.2, 1e-5);
+    let (forces, turned, angles) = quasi_static_hinges(&["pipe.ball_keys.groove_radius=0.0078"]);
+    let (model, per_hinge) = section_model(1800.0, k, 2.2, 1e-5, 0.0078);
     // The section model's operating angle: cos α′ = a cos 45° / (a + s + δ), δ = (F/K)^(1/n).
     let (a, s) = (0.0078 - 0.0075 - 1e-5, 1e-5);
     let delta = (model / k).powf(1.0 / 2.2);
@@ -322,6 +333,51 @@ fn with_the_paper_law_the_contact_angle_opens_and_keys_carry_less() {
         ((turned - 2.0 * per_hinge) / (2.0 * per_hinge)).abs() < 0.05,
         "turned {turned} rad vs {}",
         2.0 * per_hinge
+    );
+}
+
+/// docs/model.md §3 (groove conformity): with the default open arch
+/// (ρ_g = 30 mm, a = ρ_g − r_b − s = 22.49 mm) the contact angle stays within
+/// 5° of 45° up to the paper's peak key load of 33.5 kN under its own law.
+/// 4.47 kN·m through one hinge gives T/(6·PCR·sin 45°) = 33.5 kN per key at
+/// 45°; the section model then sinks a key δ = (F/K)^(1/2.2) = 0.61 mm and
+/// opens the angle to acos(a cos 45°/(a + s + δ)) = 46.5°. Measured: 45.0°
+/// on the head race, 48.7° on the seat race (the 2-D section leaves out the
+/// seat flank's smaller core radius and the 7.2° track offset); a 15 mm
+/// arch gives 48.3°/51.7°, 20 mm 46.4°/49.9°. The close arch (ρ_g = 7.8 mm)
+/// opens to 76° under the same load (section model), so the 5° bound tells
+/// the two apart by far.
+#[test]
+fn with_the_default_groove_the_contact_angle_holds_at_the_papers_peak_key_load() {
+    let torque = 33_500.0 * 6.0 * 0.0315 * std::f64::consts::FRAC_PI_4.sin();
+    let (forces, _, angles) = quasi_static_hinges(&[&format!("load.resisting_moment={torque}")]);
+    let k = 1e5 * 1000f64.powf(2.2);
+    let (model, _) = section_model(torque, k, 2.2, 1e-5, 0.030);
+    let (a, s) = (0.030 - 0.0075 - 1e-5, 1e-5);
+    let opened = |rho_a: f64| {
+        let delta = (model / k).powf(1.0 / 2.2);
+        (rho_a * std::f64::consts::FRAC_PI_4.cos() / (rho_a + s + delta))
+            .acos()
+            .to_degrees()
+    };
+    assert!(
+        (opened(a) - 46.5).abs() < 0.1,
+        "section model α′ = {}°",
+        opened(a)
+    );
+    assert!(opened(0.0078 - 0.0075 - 1e-5) > 70.0);
+    for (i, (inner, outer)) in angles.iter().enumerate() {
+        for angle in [inner, outer] {
+            assert!(
+                (angle - 45.0).abs() < 5.0,
+                "key {i}: contact angle {angle}°"
+            );
+        }
+    }
+    let mean = forces.iter().map(|(h, s)| h + s).sum::<f64>() / (2.0 * forces.len() as f64);
+    assert!(
+        ((mean - model) / model).abs() < 0.03,
+        "mean key force {mean} N vs section model {model} N"
     );
 }
 
@@ -462,10 +518,12 @@ fn two_link_chain(hinge: &str) -> (Vec<f64>, Vec<f64>) {
 /// a 0.5° tolerance would fail here) and (2) it is explained: the bend at
 /// hinge 1 predicted by the law of cosines on the triangle h0–h1–h2, from the
 /// ball-key chain's measured sides and the fixed connectors' h0–h2 distance,
-/// matches its mean bend within 0.1° (measured 9.18° vs 9.15°, 0.03°). The
-/// 0.1° covers the lateral hinge offsets (≤ 0.2 mm over 200 mm: 0.06°) and the
-/// drift of the bend within the 0.15 s averaging window (0.05°); it is 15×
-/// below the 1.5° being explained: without the lengthening the prediction is
+/// matches its mean bend within 0.2° (measured with the close 7.8 mm groove
+/// 9.18° vs 9.15°; with the default open groove 8.94° vs 8.80°). The 0.2°
+/// covers the lateral hinge offsets (≤ 0.2 mm over 200 mm: 0.06°), the
+/// drift of the bend within the 0.15 s averaging window and the hinge
+/// centre taken midway between the two bodies' hinge points; it is 6×
+/// below the 1.3° being explained: without the lengthening the prediction is
 /// the ideal-CV bend.
 #[test]
 fn ideal_cv_and_ball_keys_differ_on_a_short_chain_by_the_hinges_axial_play() {
@@ -494,7 +552,7 @@ fn ideal_cv_and_ball_keys_differ_on_a_short_chain_by_the_hinges_axial_play() {
             .acos()
             .to_degrees();
     assert!(
-        (predicted - keys[1]).abs() < 0.1,
+        (predicted - keys[1]).abs() < 0.2,
         "hinge 1: {}° measured, {predicted}° from the hinge spans",
         keys[1]
     );
@@ -539,11 +597,14 @@ fn hinge_torque_on(sim: &mut Simulation, body: usize) -> ballcage_core::math::Ve
 ///   of it (computed from contact points and joint states).
 ///
 /// Tolerance 0.1 % (1.8 N·m) on both: at t = 0.12 s, 80 ms after the ramp
-/// ended, the measured residuals are below 1e-10 relative (ideal-cv and
-/// ball-keys, the lower connector turning at < 2e-8 rad/s). A hinge that lost
-/// one of six keys or mis-signed a twist spring would be off by ≥ 1/6 or 2×;
-/// a connector still swinging at the 0.1 % level would be caught here and by
-/// the rest check (|ω| < 1e-3 rad/s).
+/// ended, the measured residuals are below 1e-3 relative (ideal-cv and
+/// ball-keys; with the default open groove the ball-key lower connector still
+/// turns at 2.3e-3 rad/s, a twist vibration of about 2e-6 rad). A hinge that
+/// lost one of six keys or mis-signed a twist spring would be off by ≥ 1/6
+/// or 2×; a connector still swinging at the 0.1 % level (1.8 N·m over the
+/// hinges' ~5e4 N·m/rad secant twist stiffness, 3.6e-5 rad, at their
+/// ~1.2e3 rad/s twist frequency: 0.04 rad/s) would be caught here and by the
+/// rest check (|ω| < 1e-2 rad/s).
 #[test]
 fn at_rest_the_drive_and_the_hinge_both_balance_the_resisting_moment() {
     for (hinge, dt) in [("ideal-cv", "1e-5"), ("ball-keys", "2e-7")] {
@@ -589,7 +650,7 @@ fn at_rest_the_drive_and_the_hinge_both_balance_the_resisting_moment() {
             "{hinge}: the hinge exerts {from_hinge} N·m on the lower connector"
         );
         assert!(
-            spin.abs() < 1e-3,
+            spin.abs() < 1e-2,
             "{hinge}: the lower connector turns at {spin} rad/s"
         );
         assert!(
@@ -886,8 +947,9 @@ fn an_ideal_cv_link_under_torque_carries_the_hinge_shear_2t_tan_half_beta_over_l
 #[test]
 fn a_tube_bent_tighter_than_the_hinges_allow_is_refused_with_the_limit() {
     // On an arc of radius R, links of pitch p bend 2·asin(p / 2R) at each
-    // interior hinge: at R = 0.7 m, 16.43° > the 15° limit; the tightest
-    // radius is p / (2 sin 7.5°) = 0.7661 m, which is accepted.
+    // interior hinge: at R = 0.7 m, 16.43° > the 14.92° limit where the
+    // neck meets the seat's mouth, β = acos(19/32.01) − asin(20/32.01); the
+    // tightest radius is p / (2 sin(β/2)) = 0.7701 m, which is accepted.
     let load = |r: &str| {
         Document::from_toml_str(
             "kind = \"drill-pipe\"\n",
@@ -898,15 +960,16 @@ fn a_tube_bent_tighter_than_the_hinges_allow_is_refused_with_the_limit() {
     assert_eq!(e.path, "borehole.curvature_radius");
     let expect = 2.0 * (0.1_f64 / 0.7).asin().to_degrees();
     assert!(e.reason.contains(&format!("{expect:.2}°")), "{e}");
-    assert!(e.reason.contains("0.7661 m"), "{e}");
-    assert!(load("0.7662").is_ok());
+    assert!(e.reason.contains("0.7701 m"), "{e}");
+    assert!(load("0.7702").is_ok());
+    assert!(load("0.7700").is_err());
     // Eq. (9): a 0.6 m link of Ø86 mm in the Ø116 mm tube needs R ≥ 0.3^2/0.06 − 0.043 = 1.457 m.
     let e = Document::from_toml_str(
         "kind = \"drill-pipe\"\n",
         &[
             "pipe.pitch=0.6".to_string(),
             "borehole.curvature_radius=1.4".to_string(),
-            "pipe.ball_keys.bend_limit_deg=60".to_string(),
+            "pipe.neck_radius=0".to_string(),
         ],
     )
     .unwrap_err();

@@ -20,10 +20,11 @@ const STEP: f64 = 2e-5;
 /// Recommended SDIRK2 step with every extreme at once [s].
 const STACKED_STEP: f64 = 2e-6;
 
-/// The tightest curvature the hinge allows: 15° articulation stop over the
-/// 200 mm pitch, R = p / (2·sin(β/2)) = 0.766 m (eq. (9) of the paper does
-/// not bind first for these joints); rounded up to stay just inside.
-const TIGHTEST_RADIUS: f64 = 0.77;
+/// The tightest curvature the hinge allows: the neck meets the seat's mouth
+/// at β = 14.92° (docs/model.md §3), over the 200 mm pitch
+/// R = p / (2·sin(β/2)) = 0.7701 m (eq. (9) of the paper does not bind first
+/// for these joints); rounded up to stay just inside.
+const TIGHTEST_RADIUS: f64 = 0.771;
 
 const EXTREMES: [(&str, &[&str]); 5] = [
     (

@@ -216,8 +216,6 @@ fn joint_damper_jacobian_matches_finite_differences() {
         damping = 2e3
         twist_stiffness = 1e5
         twist_damping = 50.0
-        bend_limit_deg = 20.0
-        stop_stiffness = 1e4
         "#,
     );
     let compared = check_jacobian(&sim, 1e-5);

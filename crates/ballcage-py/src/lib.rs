@@ -28,7 +28,13 @@ create_exception!(
 );
 
 fn scene_err(py: Python<'_>, e: ballcage_core::SceneError) -> PyErr {
-    let err = SceneError::new_err(e.to_string());
+    // An error of the document as a whole (a TOML syntax error) names no field.
+    let message = if e.path.is_empty() {
+        e.reason.clone()
+    } else {
+        e.to_string()
+    };
+    let err = SceneError::new_err(message);
     let value = err.value(py);
     // Attributes for programmatic access; setting them on a fresh exception cannot fail in practice.
     let _ = value.setattr("path", e.path.clone());
@@ -101,9 +107,15 @@ impl Scene {
             .map_err(|e| scene_err(py, e))
     }
 
-    /// The resolved scene as TOML, every default written out.
-    fn to_toml(&self) -> String {
-        self.inner.to_toml()
+    /// The resolved scene as TOML, every default written out; with `units`,
+    /// each number's unit as a comment at the end of its line.
+    #[pyo3(signature = (*, units = false))]
+    fn to_toml(&self, units: bool) -> String {
+        if units {
+            self.inner.to_toml_with_units()
+        } else {
+            self.inner.to_toml()
+        }
     }
 
     /// Scene name.
@@ -158,6 +170,13 @@ impl Scene {
     /// The tightest guide-tube curvature radius [m] the drill pipe allows.
     fn tightest_radius(&self, py: Python<'_>) -> PyResult<f64> {
         Ok(self.drill_pipe(py, "tightest_radius")?.0.tightest_radius())
+    }
+
+    /// The hinges' articulation limit [deg], the bend at which a hinge
+    /// binds; `None` when nothing limits the bend.
+    fn articulation_limit_deg(&self, py: Python<'_>) -> PyResult<Option<f64>> {
+        let spec = self.drill_pipe(py, "articulation_limit_deg")?.0;
+        Ok(spec.articulation_limit().map(f64::to_degrees))
     }
 
     /// `count` points along the drill pipe's extended tube centreline.

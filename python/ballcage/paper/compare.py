@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from collections.abc import Mapping
@@ -30,7 +31,7 @@ from ballcage.paper.frames import argmax_where, frame_grid, frame_times
 from ballcage.paper.motion import MostFrequent, centre_paths, last_revolution, most_frequent
 from ballcage.run import Run
 
-__all__ = ["COMPARISON_SCHEMA", "comparison", "fmt"]
+__all__ = ["COMPARISON_SCHEMA", "PHASES_KEY", "PhaseListing", "comparison", "fmt", "phase_listing"]
 
 COMPARISON_SCHEMA = pa.schema(
     [
@@ -42,6 +43,10 @@ COMPARISON_SCHEMA = pa.schema(
         pa.field("note", pa.string(), metadata={"description": "suspect values, differing definitions, details"}),
     ]
 )
+#: Schema metadata key of Table 3's phases in the run (`PhaseListing.to_json`: ``note``, the text the notes of
+#: Table 3's rows end with, ``phases``, one line per phase, and ``outside``); absent when no phase lies in the run.
+#: ``comparison.md`` prints the phases once, under the table, instead of in every note.
+PHASES_KEY = "ballcage.phases"
 #: Rows whose value is an index (a link number): a ratio of two indices means nothing.
 INDEX_KEYS = frozenset({"most_deformed_joint"})
 #: A sweep row's key: ``sweep_<variant>_<what>_n``.
@@ -69,6 +74,7 @@ def comparison(run: Run, sweep_runs: Mapping[str, Run] | None = None) -> pa.Tabl
     """
     facts = scene_facts(run)
     values = _baseline_values(run, facts)
+    listing = phase_listing(run, facts)
     columns: dict[str, list[Any]] = {f.name: [] for f in COMPARISON_SCHEMA}
     for spec in row_specs(reference().get("quantity", [])):
         for name, cell in _row(spec, _value(spec.key, values, sweep_runs)).items():
@@ -78,6 +84,8 @@ def comparison(run: Run, sweep_runs: Mapping[str, Run] | None = None) -> pa.Tabl
         "ballcage.run_duration_s": repr(facts.duration),
         "ballcage.version": _native.__version__,
     }
+    if listing is not None:
+        meta[PHASES_KEY] = listing.to_json()
     return pa.Table.from_pydict(columns, schema=COMPARISON_SCHEMA.with_metadata(meta))
 
 
@@ -164,17 +172,12 @@ def _phase_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
     """Table 3's rows: included angles, the two ranges of motion and the most deformed joint."""
     if "links" not in run.tables:
         return {k: _Value(None, "not computed: the run did not record the links table") for k in _PHASE_KEYS}
-    found, skipped = phases(run, facts)
+    found, _ = phases(run, facts)
     if not found:
         return {k: _Value(None, "not computed: none of the four phases lies in the run") for k in _PHASE_KEYS}
-    listing = ", ".join(
-        f"{p.label} t={p.t:.3f} s: link {p.most_deformed}, {p.included_angle:.2f} deg at hinge {p.most_deformed}, "
-        f"{p.offset_mm:.2f} mm"
-        for p in found
-    )
-    where = f"phases ({listing})"
-    if skipped:
-        where += f"; {len(found)} of 4 phases in the run ({', '.join(skipped)} fall before t = 0)"
+    listing = phase_listing(run, facts)
+    assert listing is not None  # a phase was found
+    where = listing.note
     chosen = most_frequent([p.most_deformed for p in found], [p.offset_mm for p in found])
     angles = [p.included_angle for p in found]
     hinges = ", ".join(str(p.most_deformed) for p in found)
@@ -196,6 +199,39 @@ def _phase_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
             float(chosen.link), f"{DEFINITIONS['most_deformed_joint']}; {_choice_note(chosen, found)}; {where}"
         ),
     }
+
+
+@dataclass(frozen=True)
+class PhaseListing:
+    """Table 3's phases in a run: one line per phase, which fall outside it, and the text the notes end with."""
+
+    items: list[str]  # "0° t=1.350 s: link 11, 168.16 deg at hinge 11, 14.76 mm"
+    outside: str  # "1 of 4 phases in the run (0°, 90°, 180° fall before t = 0)", or ""
+
+    @property
+    def note(self) -> str:
+        """What the notes of Table 3's rows end with: ``phases (…)[; … fall before t = 0]``."""
+        text = f"phases ({', '.join(self.items)})"
+        return f"{text}; {self.outside}" if self.outside else text
+
+    def to_json(self) -> str:
+        return json.dumps({"note": self.note, "phases": self.items, "outside": self.outside}, ensure_ascii=False)
+
+
+def phase_listing(run: Run, facts: SceneFacts) -> PhaseListing | None:
+    """The phases of Table 3 found in the run; ``None`` without a links table or a phase in the run."""
+    if "links" not in run.tables:
+        return None
+    found, skipped = phases(run, facts)
+    if not found:
+        return None
+    items = [
+        f"{p.label} t={p.t:.3f} s: link {p.most_deformed}, {p.included_angle:.2f} deg at hinge {p.most_deformed}, "
+        f"{p.offset_mm:.2f} mm"
+        for p in found
+    ]
+    outside = f"{len(found)} of 4 phases in the run ({', '.join(skipped)} fall before t = 0)" if skipped else ""
+    return PhaseListing(items, outside)
 
 
 def _choice_note(chosen: MostFrequent, found: list[Phase]) -> str:

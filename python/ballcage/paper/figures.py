@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ballcage._files import write_png
-from ballcage._plot import colormap, figure, no_data
+from ballcage._plot import figure, no_data, series_styles
 from ballcage.paper.definitions import TUBE_LINKS
 from ballcage.paper.facts import SceneFacts, phases, scene_facts
 from ballcage.paper.frames import frame_grid, frame_times
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["FIGURES", "KEY_BODIES", "write_figures"]
+__all__ = ["FIGURES", "KEY_BODIES", "articulation_limit_deg", "write_figures"]
 
 #: Figure files (without ``.png``), in the order they are written.
 FIGURES: tuple[str, ...] = (
@@ -53,13 +53,24 @@ def write_figures(run: Run, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
     return {name: write_png(makers[name](), out / f"{name}.png") for name in FIGURES}
 
 
+def articulation_limit_deg(run: Run) -> float | None:
+    """The bend [deg] at which the run's hinges bind, ``None`` when nothing limits it.
+
+    The one place the figures read the limit (`ballcage.Scene.articulation_limit_deg`:
+    where the head's neck meets the seat's mouth).
+    """
+    return run.scene.articulation_limit_deg()
+
+
 def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
     """Fig. 9: the included angle at hinge k between link k and link k+1 (links.included_angle_deg of link k).
 
     Hinges 1-11 join two links (the paper's adjacent joints); hinge 12 joins
-    link 12 and the lower connector and is drawn apart (hollow markers, dashed).
+    link 12 and the lower connector and is drawn apart (hollow markers; dotted over time).
+    A dotted line marks 180 deg minus the articulation limit, where hinges
+    that bind stay flat.
     """
-    fig = figure(figsize=(11, 4.5))
+    fig = figure(figsize=(12, 5))
     by_hinge, over_time = fig.subplots(1, 2)
     links = run.tables.get("links")
     found, skipped = phases(run, facts)
@@ -71,17 +82,22 @@ def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figu
             (line,) = by_hinge.plot(inner, grid[p.frame, :-1], marker="o", label=f"{p.label} (t = {p.t:.3f} s)")
             by_hinge.plot(hinges[-1:], grid[p.frame, -1:], marker="o", mfc="none", ls="none", color=line.get_color())
         by_hinge.set_xticks(hinges)
-        cmap = colormap("viridis")
-        for k in range(grid.shape[1]):
-            last = k == grid.shape[1] - 1
-            label = f"hinge {k + 1}" + (" (lower conn.)" if last else "")
-            color = cmap(k / max(grid.shape[1] - 1, 1))
-            over_time.plot(times, grid[:, k], color=color, lw=1, ls="--" if last else "-", label=label)
-        over_time.legend(fontsize=7, ncol=2, loc="best")
+        _included_angles_over_time(over_time, times, grid)
     else:
         no_data(over_time, "no links table")
-    if found:
-        by_hinge.legend(fontsize=8, title="phase of the upper connector", title_fontsize=8)
+    limit = articulation_limit_deg(run)
+    if limit is not None:
+        label = f"articulation limit {180.0 - limit:.2f} deg (180 - {limit:.2f})"
+        for ax in (by_hinge, over_time):
+            ax.axhline(180.0 - limit, color="k", ls=":", lw=1.2, zorder=0, label=label)
+            ax.margins(y=0.08)
+    if links is not None and links.num_rows:
+        over_time.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5), title="hinge", title_fontsize=7)
+    if found or limit is not None:
+        low = by_hinge.get_ylim()[0]
+        by_hinge.set_ylim(low, 180.0 + 0.4 * (180.0 - low))  # room above 180 deg (straight) for the legend
+        by_hinge.set_yticks([t for t in by_hinge.get_yticks() if low <= t <= 180.0])
+        by_hinge.legend(fontsize=7, title="phase of the upper connector", title_fontsize=7, loc="upper center", ncol=2)
     if skipped:
         by_hinge.text(
             0.01, 0.01, f"phases before t = 0 not shown: {', '.join(skipped)}", transform=by_hinge.transAxes, fontsize=7
@@ -98,6 +114,19 @@ def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figu
         fontsize=10,
     )
     return fig
+
+
+def _included_angles_over_time(ax: Axes, times: np.ndarray, grid: np.ndarray) -> None:
+    """One line per hinge, each with its own colour, line style and marker."""
+    count = grid.shape[1]
+    every = max(len(times) // 12, 1)
+    for k, style in enumerate(series_styles(count)):
+        last = k == count - 1
+        label = f"hinge {k + 1}" + (" (lower conn.)" if last else "")
+        if last:  # drawn apart, as in the left panel: dotted, hollow markers
+            style = {**style, "ls": ":", "mfc": "none"}
+        offset = (k * every) // max(count, 1)  # markers of neighbouring hinges do not sit on one time
+        ax.plot(times, grid[:, k], lw=1, ms=4, markevery=(offset, every), label=label, **style)
 
 
 def _fig_tube(run: Run, times: np.ndarray, *, normal: bool) -> Figure:

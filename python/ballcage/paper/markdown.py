@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Mapping
+from typing import Any
 
 import pyarrow as pa
 
-from ballcage.paper.compare import fmt
+from ballcage.paper.compare import PHASES_KEY, fmt
 from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS
 from ballcage.paper.facts import scene_facts
 from ballcage.run import Run
@@ -50,13 +52,34 @@ def comparison_markdown(
         "| key | paper | ours | unit | ratio | note |",
         "| --- | ---: | ---: | --- | ---: | --- |",
     ]
+    phases = json.loads((table.schema.metadata or {}).get(PHASES_KEY.encode(), b"{}"))
     for r in table.to_pylist():
         paper = "" if r["paper"] is None else fmt(r["paper"])
         ours = "" if r["ours"] is None else fmt(r["ours"])
         ratio = "" if r["ratio"] is None else f"{r['ratio']:.3f}"
-        note = str(r["note"]).replace("|", "\\|")
+        note = str(r["note"])
+        if phases.get("note"):
+            note = note.replace(phases["note"], "phases: listed under the table")
+        note = note.replace("|", "\\|")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines + _phase_lines(phases)) + "\n"
+
+
+def _phase_lines(phases: Mapping[str, Any]) -> list[str]:
+    """Table 3's phases (`PHASES_KEY`), listed once under the table."""
+    if not phases.get("phases"):
+        return []
+    lines = [
+        "",
+        "Phases of Table 3, the upper connector's angle in its last revolution (the rows above marked "
+        '"phases: listed under the table"): at each, the most deformed link (largest links.radial_offset), '
+        "the included angle at its hinge and its centre offset.",
+        "",
+    ]
+    lines += [f"- {item}" for item in phases["phases"]]
+    if phases.get("outside"):
+        lines += ["", f"Only {phases['outside']}."]
+    return lines
 
 
 def _extra_rows_sentence() -> str:
@@ -67,6 +90,6 @@ def _extra_rows_sentence() -> str:
     ]
     return (
         f"Rows the reference file lacks follow the row they belong to: {', '.join(parts)}; "
-        "the per-phase rows of Table 3 (most deformed link, included angle at hinge k between link k and link k+1) "
-        "list each phase in the note."
+        "the phases behind Table 3's rows (most deformed link, included angle at hinge k between link k and link k+1, "
+        "range of motion) are listed once, under the table."
     )

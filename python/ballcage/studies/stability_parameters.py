@@ -39,15 +39,15 @@ DAMPING_RANGE = (0.1, 100.0)  # N·s/mm, plus zero
 def tightest_radius(scene: SceneSource | None = None) -> float:
     """The tightest tube curvature radius [m] the hinge allows, whichever binds first of:
 
-    * the articulation stop: on an arc of radius R, links of pitch p bend by
-      2·asin(p / 2R) at each joint, which ``bend_limit_deg`` (ball keys or ideal
-      CV) bounds: R = p / (2 sin(limit / 2)) — 0.766 m for the paper's 200 mm
-      pitch and 15° stop;
+    * the articulation limit: on an arc of radius R, links of pitch p bend by
+      2·asin(p / 2R) at each joint, which the head's neck meeting the cage rim
+      (``pipe.neck_radius``, docs/model.md §3) bounds: R = p / (2 sin(limit / 2))
+      — 0.800 m for the paper's 200 mm pitch and the 14.36° limit;
     * the paper's eq. (9), the longest rigid link of radius r that fits the
       tube (diameter D): L = 2·√(2(D − 2r)(R + r)), so R = (p/2)² / (2(D − 2r)) − r
       — 0.124 m for the paper's 86 mm links in the 116 mm tube.
 
-    The stop binds first for the paper's pipe. `scene`: anything
+    The articulation limit binds first for the paper's pipe. `scene`: anything
     `ballcage.load_scene` takes; ``None`` is the embedded paper scene
     (`ballcage.Scene.tightest_radius`). Raises `ballcage.SceneError` (path
     ``kind``) for a generic scene.

@@ -16,8 +16,7 @@ pub(super) fn joints(scene: &Scene) -> Result<Vec<Joint>, SceneError> {
         .collect()
 }
 
-/// Joint `i`: a constant-velocity joint, or a bend stop (a CV joint with
-/// only its stop).
+/// Joint `i`: a constant-velocity joint.
 fn joint(scene: &Scene, j: &JointSpec, i: usize) -> Result<Joint, SceneError> {
     let path = format!("joints[{i}]");
     let ids = |names: &[String; 2]| -> Result<(usize, usize), SceneError> {
@@ -36,8 +35,6 @@ fn joint(scene: &Scene, j: &JointSpec, i: usize) -> Result<Joint, SceneError> {
             damping,
             twist_stiffness,
             twist_damping,
-            bend_limit_deg,
-            stop_stiffness,
         } => {
             let (a, b) = ids(names)?;
             Joint {
@@ -51,31 +48,6 @@ fn joint(scene: &Scene, j: &JointSpec, i: usize) -> Result<Joint, SceneError> {
                     damping: *damping,
                     twist_stiffness: *twist_stiffness,
                     twist_damping: *twist_damping,
-                    bend_limit: bend_limit_deg.to_radians(),
-                    stop_stiffness: *stop_stiffness,
-                },
-            }
-        }
-        JointSpec::BendStop {
-            name,
-            bodies: names,
-            bend_limit_deg,
-            stop_stiffness,
-        } => {
-            let (a, b) = ids(names)?;
-            Joint {
-                name: default_name(name),
-                a,
-                b,
-                anchor_a: Vec3::zeros(),
-                anchor_b: Vec3::zeros(),
-                params: CvJointParams {
-                    stiffness: 0.0,
-                    damping: 0.0,
-                    twist_stiffness: 0.0,
-                    twist_damping: 0.0,
-                    bend_limit: bend_limit_deg.to_radians(),
-                    stop_stiffness: *stop_stiffness,
                 },
             }
         }

@@ -2,7 +2,7 @@
 
 use super::laws::{friction_law, normal_law};
 use crate::error::SceneError;
-use crate::geometry::{PairGeometry, Shape};
+use crate::geometry::{PairGeometry, RingCylinder, Shape};
 use crate::math::Vec3;
 use crate::model::{Body, ContactPair, Motion};
 use crate::scene::{ContactSpec, FeatureSpec, Scene, ShapeSpec};
@@ -85,16 +85,9 @@ pub(super) fn pair_geometry(
     Ok((feature_geometry(c, feature, path, specs[1])?, false))
 }
 
-/// The point finder of an explicit feature; each feature holds ball b, of
-/// shape `b`, whose radius must fit the feature.
-fn feature_geometry(
-    c: &ContactSpec,
-    feature: &FeatureSpec,
-    path: &str,
-    b: &ShapeSpec,
-) -> Result<PairGeometry, SceneError> {
-    let g = format!("{path}.geometry");
-    let ball_radius = || match b {
+/// The radius of pair `c`'s body b, of shape `b`, which a ball feature needs to be a ball.
+fn ball_radius(c: &ContactSpec, path: &str, b: &ShapeSpec) -> Result<f64, SceneError> {
+    match b {
         ShapeSpec::Ball { radius } => Ok(*radius),
         other => Err(SceneError::new(
             format!("{path}.bodies[1]"),
@@ -104,7 +97,19 @@ fn feature_geometry(
                 other.kind_name()
             ),
         )),
-    };
+    }
+}
+
+/// The point finder of an explicit feature; the ball features hold ball b, of
+/// shape `b`, whose radius must fit the feature.
+fn feature_geometry(
+    c: &ContactSpec,
+    feature: &FeatureSpec,
+    path: &str,
+    b: &ShapeSpec,
+) -> Result<PairGeometry, SceneError> {
+    let g = format!("{path}.geometry");
+    let ball_radius = || ball_radius(c, path, b);
     let narrower = |field: &str, width: f64, r: f64| {
         SceneError::new(
             format!("{g}.{field}"),
@@ -158,6 +163,21 @@ fn feature_geometry(
             sphere_centre: Vec3::from(*sphere_centre),
             sphere_radius: *sphere_radius,
         },
+        FeatureSpec::RingCylinder {
+            ring_centre,
+            ring_axis,
+            ring_radius,
+            axis_point,
+            axis_direction,
+            cylinder_radius,
+        } => PairGeometry::RingCylinder(RingCylinder {
+            ring_centre: Vec3::from(*ring_centre),
+            ring_axis: Vec3::from(*ring_axis).normalize(),
+            ring_radius: *ring_radius,
+            axis_point: Vec3::from(*axis_point),
+            axis_direction: Vec3::from(*axis_direction).normalize(),
+            cylinder_radius: *cylinder_radius,
+        }),
     })
 }
 

@@ -143,7 +143,9 @@ impl Placement {
                 ),
             ));
         }
-        let limit = spec.bend_limit_deg();
+        let Some(limit) = spec.articulation_limit().map(f64::to_degrees) else {
+            return Ok(());
+        };
         let (h, bend) = (0..self.axes.len() - 1)
             .map(|h| {
                 (
@@ -158,8 +160,8 @@ impl Placement {
                 r,
                 format!(
                     "placed on this arc, hinge {h} bends {bend:.2}°, beyond the hinge's \
-                     articulation limit of {limit}°; chains of two or more links need \
-                     R ≥ {:.4} m",
+                     articulation limit of {limit:.2}° (where the head's neck, pipe.neck_radius, \
+                     meets the seat's mouth); chains of two or more links need R ≥ {:.4} m",
                     spec.tightest_radius()
                 ),
             ));
@@ -378,24 +380,44 @@ impl<'a> Builder<'a> {
             damping: c.damping,
             twist_stiffness: c.twist_stiffness,
             twist_damping: c.twist_damping,
-            bend_limit_deg: c.bend_limit_deg,
-            stop_stiffness: c.stop_stiffness,
         });
-        self.layout.hinges.push(HingeLayout::default());
+        let neck = self.neck_contact(h);
+        self.layout.hinges.push(HingeLayout {
+            neck,
+            ..HingeLayout::default()
+        });
     }
 
-    /// Hinge `h` as the paper's ball-cage joint: articulation stop, cage,
-    /// and six ball keys with their race and window contacts.
+    /// The articulation limit of hinge `h`: the head's neck against the
+    /// seat's mouth, a contact of the joint's internal material; None when
+    /// `pipe.neck_radius` is 0.
+    fn neck_contact(&mut self, h: usize) -> Option<usize> {
+        self.spec.articulation_limit()?;
+        let (r_neck, kb) = (self.spec.pipe.neck_radius, &self.spec.pipe.ball_keys);
+        let (c_head, c_seat) = self.hinge_anchors(h);
+        let geometry = FeatureSpec::RingCylinder {
+            ring_centre: arr(&(c_seat - kb.mouth_offset * Vec3::x())),
+            ring_axis: [1.0, 0.0, 0.0],
+            ring_radius: kb.mouth_radius(),
+            axis_point: arr(&c_head),
+            axis_direction: [1.0, 0.0, 0.0],
+            cylinder_radius: r_neck,
+        };
+        let part = PairPart {
+            hinge: Some(h as u32),
+            ..PairPart::of(Feature::NeckMouth)
+        };
+        let (head, seat) = (self.chain_name(h), self.chain_name(h + 1));
+        Some(self.internal_contact(names::neck(h), [&seat, &head], geometry, part))
+    }
+
+    /// Hinge `h` as the paper's ball-cage joint: cage, neck–mouth
+    /// articulation contact, and six ball keys with their race and window
+    /// contacts.
     fn ball_key_hinge(&mut self, h: usize) {
         let kb = &self.spec.pipe.ball_keys;
         let (head, seat) = (self.chain_name(h), self.chain_name(h + 1));
         let beta = chain::bend_angle(&self.place.axes[h], &self.place.axes[h + 1], &BEND_NORMAL);
-        self.joints.push(JointSpec::BendStop {
-            name: Some(names::stop(h)),
-            bodies: [head.clone(), seat.clone()],
-            bend_limit_deg: kb.bend_limit_deg,
-            stop_stiffness: kb.stop_stiffness,
-        });
         let r_cage = self.place.rotations[h] * Quat::from_axis_angle(&Vec3::z_axis(), beta / 2.0);
         let cage = BodySpec {
             name: names::cage(h),
@@ -411,6 +433,7 @@ impl<'a> Builder<'a> {
         };
         self.push_body(cage);
         let mut layout = self.cage_contacts(h, &head, &seat);
+        layout.neck = self.neck_contact(h);
         for j in 0..6 {
             layout.keys.push(self.ball_key(h, j, beta, &head, &seat));
         }
@@ -473,7 +496,7 @@ impl<'a> Builder<'a> {
         HingeLayout {
             cage_head: Some(cage_head),
             cage_seat: Some(cage_seat),
-            keys: vec![],
+            ..HingeLayout::default()
         }
     }
 
@@ -603,7 +626,7 @@ impl<'a> Builder<'a> {
             summary_window: r.summary_window.clone(),
         };
         let scene = Scene {
-            name: spec.name.clone(),
+            name: spec.title(),
             simulation: spec.simulation.clone(),
             world: WorldSpec {
                 gravity: [0.0, 0.0, -spec.world.gravity],

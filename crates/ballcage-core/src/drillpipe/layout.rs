@@ -20,6 +20,8 @@ pub enum Feature {
     OuterRace,
     /// A ball key on a face of its cage window.
     Window,
+    /// The ball head's neck against the seat's mouth (the articulation limit).
+    NeckMouth,
 }
 
 impl Feature {
@@ -31,6 +33,7 @@ impl Feature {
         "inner-race",
         "outer-race",
         "window",
+        "neck-mouth",
     ];
 
     /// Index into [`Feature::LABELS`].
@@ -96,6 +99,8 @@ pub struct HingeLayout {
     pub cage_head: Option<usize>,
     /// Cage–seat pair.
     pub cage_seat: Option<usize>,
+    /// Neck–mouth pair (the articulation limit), if `pipe.neck_radius` > 0.
+    pub neck: Option<usize>,
     /// The ball keys, 0–5 around the joint.
     pub keys: Vec<KeyLayout>,
 }

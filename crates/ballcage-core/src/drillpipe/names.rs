@@ -31,9 +31,9 @@ pub fn hinge(h: usize) -> String {
     format!("h{h:02}")
 }
 
-/// The articulation stop of hinge `h`.
-pub fn stop(h: usize) -> String {
-    format!("{}.stop", hinge(h))
+/// The neck–mouth contact (articulation limit) of hinge `h`.
+pub fn neck(h: usize) -> String {
+    format!("{}.neck", hinge(h))
 }
 
 /// The cage of hinge `h`.

@@ -1,7 +1,7 @@
 //! Geometric limits of a drill pipe in a curved tube: the paper's eq. (9)
 //! and the hinge's articulation limit.
 
-use super::spec::{DrillPipeSpec, HingeModel};
+use super::spec::{BallKeySpec, DrillPipeSpec};
 
 /// The paper's eq. (9): the longest rigid link [m] of radius `link_radius`
 /// that fits a tube of inner diameter `tube_diameter` bent to centreline
@@ -28,21 +28,61 @@ pub fn tightest_radius_for_bend(pitch: f64, bend_limit: f64) -> f64 {
     pitch / (2.0 * (bend_limit / 2.0).sin())
 }
 
+/// The bend [rad] at which a neck of radius `neck` through a ring of radius
+/// ρ at axial distance h from the hinge centre touches the ring when the
+/// ring tilts against the neck: the ring's nearest point is
+/// ρ·cos t − h·sin t = R·cos(t + asin(h/R)) from the neck's axis,
+/// R = √(ρ² + h²), so t = acos(r/R) − asin(h/R).
+pub fn neck_limit(neck: f64, ring_radius: f64, ring_offset: f64) -> f64 {
+    let r = ring_radius.hypot(ring_offset);
+    (neck / r).acos() - (ring_offset / r).asin()
+}
+
+impl BallKeySpec {
+    /// Radius of the seat's mouth [m]: the seat sphere cut at `mouth_offset`.
+    pub fn mouth_radius(&self) -> f64 {
+        (self.seat_radius.powi(2) - self.mouth_offset.powi(2))
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// Radius of the cage's end openings [m]: its inner sphere cut at
+    /// ±cage_length/2.
+    pub fn rim_radius(&self) -> f64 {
+        let h = self.cage_length / 2.0;
+        (self.cage_inner_radius.powi(2) - h * h).max(0.0).sqrt()
+    }
+
+    /// The bend [rad] at which a neck of radius `neck` meets the seat's mouth:
+    /// acos(r/R_s) − asin(d_m/R_s).
+    pub fn mouth_limit(&self, neck: f64) -> f64 {
+        neck_limit(neck, self.mouth_radius(), self.mouth_offset)
+    }
+
+    /// The bend [rad] at which a neck of radius `neck` would meet the cage's
+    /// end rim, which turns by half the bend: 2·(acos(r/R_ci) − asin(L_c/2R_ci)).
+    pub fn cage_rim_limit(&self, neck: f64) -> f64 {
+        2.0 * neck_limit(neck, self.rim_radius(), self.cage_length / 2.0)
+    }
+}
+
 impl DrillPipeSpec {
-    /// The hinge model's articulation limit [deg].
-    pub fn bend_limit_deg(&self) -> f64 {
-        match self.pipe.hinge {
-            HingeModel::BallKeys => self.pipe.ball_keys.bend_limit_deg,
-            HingeModel::IdealCv => self.pipe.ideal_cv.bend_limit_deg,
-        }
+    /// The articulation limit [rad]: where the head's neck meets the seat's
+    /// mouth, β_max = acos(r_neck/R_s) − asin(d_m/R_s); `None` without a
+    /// neck contact (`pipe.neck_radius = 0`). Both hinge models share it.
+    pub fn articulation_limit(&self) -> Option<f64> {
+        let r = self.pipe.neck_radius;
+        (r > 0.0).then(|| self.pipe.ball_keys.mouth_limit(r))
     }
 
     /// The tightest tube curvature radius [m] this pipe allows: whichever
     /// binds first of the articulation limit and eq. (9). For the paper's
-    /// pipe the limit binds: 0.766 m against 0.124 m.
+    /// pipe the limit binds: 0.770 m against 0.124 m.
     pub fn tightest_radius(&self) -> f64 {
         let p = &self.pipe;
-        let bend = tightest_radius_for_bend(p.pitch, self.bend_limit_deg().to_radians());
+        let bend = self
+            .articulation_limit()
+            .map_or(0.0, |b| tightest_radius_for_bend(p.pitch, b));
         let fit =
             tightest_radius_for_link(p.pitch, self.borehole.inner_diameter, p.link_diameter / 2.0);
         bend.max(fit)
@@ -72,12 +112,31 @@ mod tests {
     }
 
     #[test]
+    fn the_articulation_limit_is_where_the_neck_meets_the_seat_mouth() {
+        // R_s = 32.01 mm, d_m = 20 mm, r_neck = 19 mm:
+        // acos(19/32.01) − asin(20/32.01) = 53.590° − 38.668° = 14.922°;
+        // the cage rim (R_ci = 31, L_c = 40) would bind only at
+        // 2·(acos(19/31) − asin(20/31)) = 2·(52.200° − 40.178°) = 24.05°.
+        let spec = DrillPipeSpec::default();
+        let limit = spec.articulation_limit().unwrap().to_degrees();
+        let expected = ((19.0f64 / 32.01).acos() - (20.0f64 / 32.01).asin()).to_degrees();
+        assert_relative_eq!(limit, expected, max_relative = 1e-12);
+        assert!((limit - 14.922).abs() < 0.001, "{limit}");
+        let rim = spec.pipe.ball_keys.cage_rim_limit(0.019).to_degrees();
+        assert!((rim - 24.045).abs() < 0.001, "{rim}");
+        let mut free = spec.clone();
+        free.pipe.neck_radius = 0.0;
+        assert_eq!(free.articulation_limit(), None);
+    }
+
+    #[test]
     fn the_paper_pipe_is_bounded_by_its_articulation_limit() {
         let spec = DrillPipeSpec::default();
-        // 0.2 / (2 sin 7.5°) = 0.76613 m; eq. (9): 0.01 / 0.06 − 0.043 = 0.12367 m.
+        // 0.2 / (2 sin(β_max/2)); eq. (9): 0.01 / 0.06 − 0.043 = 0.12367 m.
+        let beta = spec.articulation_limit().unwrap();
         assert_relative_eq!(
             spec.tightest_radius(),
-            0.2 / (2.0 * 7.5_f64.to_radians().sin()),
+            0.2 / (2.0 * (beta / 2.0).sin()),
             max_relative = 1e-12
         );
         assert_relative_eq!(

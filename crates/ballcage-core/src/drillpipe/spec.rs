@@ -56,7 +56,13 @@ pub struct BallKeySpec {
     pub pitch_radius: f64,
     /// Groove-centre offset per race, c [m]. PROPOSAL: 4 mm.
     pub groove_offset: f64,
-    /// Gothic-arch flank radius ρ_g [m]. PROPOSAL: 7.8 mm (conformity 1.04).
+    /// Gothic-arch flank radius ρ_g [m]. PROPOSAL: 30 mm (flank offset
+    /// a = ρ_g − r_b − s = 22.49 mm, nearly straight flanks at ±45°): under
+    /// the paper's soft law a key sinks 0.61 mm at its 33.5 kN peak, and the
+    /// contact angle opens as cos α′ = a·cos α/(a + s + δ), so a close arch
+    /// (7.8 mm, a = 0.29 mm) runs at 75–80°; this one stays within 4° of 45°
+    /// (docs/model.md §3). The IMPACT law's stiffness does not depend on the
+    /// conformity, so only the angle changes.
     pub groove_radius: f64,
     /// Flank contact angle α [deg]. PROPOSAL: 45.
     pub contact_angle_deg: f64,
@@ -78,10 +84,15 @@ pub struct BallKeySpec {
     pub window_axial_width: f64,
     /// Window length around the cage [m]. PROPOSAL: 16.1 mm.
     pub window_length: f64,
-    /// Articulation stop (head–seat cone contact) [deg]. PROPOSAL: 15.
-    pub bend_limit_deg: f64,
-    /// Stop stiffness [N·m/rad]. PROPOSAL: 1e6.
-    pub stop_stiffness: f64,
+    /// Cage length along its axis [m] (Table 1: 40 mm): its end openings,
+    /// cut at ±half of it, must let the neck pass farther than the seat's
+    /// mouth does (checked).
+    pub cage_length: f64,
+    /// Distance from the hinge centre to the seat's mouth, toward the head
+    /// [m]. 20 mm: the head (104 mm) and seat (136 mm) overlap by 40 mm in
+    /// the 200 mm pitch, centred on the hinge (docs/model.md §3). The mouth
+    /// is the seat's sphere cut there: radius √(seat_radius² − offset²).
+    pub mouth_offset: f64,
 }
 
 impl Default for BallKeySpec {
@@ -91,7 +102,7 @@ impl Default for BallKeySpec {
             ball_mass: 0.013872,
             pitch_radius: 0.0315,
             groove_offset: 0.004,
-            groove_radius: 0.0078,
+            groove_radius: 0.030,
             contact_angle_deg: 45.0,
             flank_clearance: 1e-5,
             head_radius: 0.03099,
@@ -102,8 +113,8 @@ impl Default for BallKeySpec {
             cage_inertia: [5.1e-5, 3.2e-5, 3.2e-5],
             window_axial_width: 0.01503,
             window_length: 0.0161,
-            bend_limit_deg: 15.0,
-            stop_stiffness: 1e6,
+            cage_length: 0.040,
+            mouth_offset: 0.020,
         }
     }
 }
@@ -120,10 +131,6 @@ pub struct IdealCvSpec {
     pub twist_stiffness: f64,
     /// Twist damper [N·m·s/rad]. PROPOSAL: 60 (about critical for a link's spin inertia).
     pub twist_damping: f64,
-    /// Articulation stop [deg]. PROPOSAL: 15.
-    pub bend_limit_deg: f64,
-    /// Stop spring [N·m/rad]. PROPOSAL: 1e6.
-    pub stop_stiffness: f64,
 }
 
 impl Default for IdealCvSpec {
@@ -133,8 +140,6 @@ impl Default for IdealCvSpec {
             damping: 1.3e5,
             twist_stiffness: 1.1e5,
             twist_damping: 60.0,
-            bend_limit_deg: 15.0,
-            stop_stiffness: 1e6,
         }
     }
 }
@@ -168,7 +173,16 @@ pub struct PipeSpec {
     /// largest penetration, so the force does not depend on this count.
     /// PROPOSAL: 5.
     pub tube_contact_points: u32,
-    /// Ball-cage joint details (used by `hinge = "ball-keys"`).
+    /// Radius of the ball head's neck, the shaft between the head sphere and
+    /// its link [m]. PROPOSAL: 19 mm (Ø38 over the Ø30 bore).
+    /// The neck meets the seat's mouth at the articulation limit
+    /// β_max = acos(r_neck/R_s) − asin(d_m/R_s) (14.92° by default;
+    /// docs/model.md §3), through a contact pair with the joint's internal
+    /// law, in both hinge models. 0 builds no neck contact: the hinges bend
+    /// freely.
+    pub neck_radius: f64,
+    /// Ball-cage joint details (used by `hinge = "ball-keys"`; its seat
+    /// and cage dimensions also set the articulation limit of both models).
     pub ball_keys: BallKeySpec,
     /// Ideal CV joint details (used by `hinge = "ideal-cv"`).
     pub ideal_cv: IdealCvSpec,
@@ -188,6 +202,7 @@ impl Default for PipeSpec {
             connector_mass: 17.243,
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
             tube_contact_points: 5,
+            neck_radius: 0.019,
             ball_keys: BallKeySpec::default(),
             ideal_cv: IdealCvSpec::default(),
         }
@@ -307,7 +322,9 @@ impl Default for GravitySpec {
 pub struct DrillPipeSpec {
     /// Always `"drill-pipe"`.
     pub kind: String,
-    /// Scene name.
+    /// Scene name; empty (the default) names the scene after its chain,
+    /// tube and loads ([`DrillPipeSpec::title`]).
+    #[serde(skip_serializing_if = "String::is_empty")]
     pub name: String,
     /// Time stepping. The paper's 1 ms is the output interval, not the step.
     /// Default: SDIRK2 at 100 µs, within 0.1 % of a converged reference on
@@ -335,11 +352,45 @@ pub struct DrillPipeSpec {
 /// The `kind` of a drill-pipe scene document.
 pub const KIND: &str = "drill-pipe";
 
+impl DrillPipeSpec {
+    /// The scene's name: `name` if set, else its chain, tube and loads, e.g.
+    /// "12 ball-cage joints, R 1.5 m, 100 rpm, 1.8 kN·m", prefixed with
+    /// "Zhu et al. 2023: " when those are the paper's.
+    pub fn title(&self) -> String {
+        if !self.name.is_empty() {
+            return self.name.clone();
+        }
+        let hinge = match self.pipe.hinge {
+            HingeModel::BallKeys => "ball-cage",
+            HingeModel::IdealCv => "ideal-CV",
+        };
+        let what = format!(
+            "{} {hinge} joints, R {} m, {} rpm, {} kN·m",
+            self.pipe.joints,
+            self.borehole.curvature_radius,
+            self.drive.speed_rpm,
+            self.load.resisting_moment / 1000.0
+        );
+        let paper = Self::default();
+        let as_paper = self.pipe.joints == paper.pipe.joints
+            && self.pipe.hinge == paper.pipe.hinge
+            && self.borehole.curvature_radius == paper.borehole.curvature_radius
+            && self.drive.speed_rpm == paper.drive.speed_rpm
+            && self.load.resisting_moment == paper.load.resisting_moment;
+        if as_paper {
+            format!("Zhu et al. 2023: {what}")
+        } else {
+            what
+        }
+    }
+}
+
 impl Default for DrillPipeSpec {
+    /// The paper's scene.
     fn default() -> Self {
         Self {
             kind: KIND.to_string(),
-            name: "Zhu et al. 2023: 12 ball-cage joints, R 1.5 m, 100 rpm, 1.8 kN·m".to_string(),
+            name: String::new(),
             simulation: SimulationSpec {
                 duration: 1.8,
                 dt: 1e-4,
@@ -497,7 +548,33 @@ impl PipeSpec {
         positive("pipe.connector_length", self.connector_length)?;
         positive("pipe.connector_diameter", self.connector_diameter)?;
         self.ideal_cv.validate()?;
-        self.ball_keys.validate()
+        self.ball_keys.validate()?;
+        non_negative("pipe.neck_radius", self.neck_radius)?;
+        let (kb, r) = (&self.ball_keys, self.neck_radius);
+        let mouth = kb.mouth_radius();
+        if r >= mouth {
+            return Err(SceneError::new(
+                "pipe.neck_radius",
+                r,
+                format!(
+                    "must be smaller than the seat's mouth, radius {mouth:.5} m \
+                     (√(seat_radius² − mouth_offset²)), or the head cannot bend"
+                ),
+            ));
+        }
+        if r > 0.0 && kb.cage_rim_limit(r) < kb.mouth_limit(r) {
+            return Err(SceneError::new(
+                "pipe.neck_radius",
+                r,
+                format!(
+                    "so thick a neck meets the cage's end rim at {:.2}° before the seat's mouth \
+                     at {:.2}°; the model limits the bend at the mouth only: use a thinner neck",
+                    kb.cage_rim_limit(r).to_degrees(),
+                    kb.mouth_limit(r).to_degrees()
+                ),
+            ));
+        }
+        Ok(())
     }
 }
 
@@ -506,8 +583,6 @@ impl IdealCvSpec {
         for (name, v) in [
             ("stiffness", self.stiffness),
             ("twist_stiffness", self.twist_stiffness),
-            ("bend_limit_deg", self.bend_limit_deg),
-            ("stop_stiffness", self.stop_stiffness),
         ] {
             positive(&format!("pipe.ideal_cv.{name}"), v)?;
         }
@@ -532,8 +607,8 @@ impl BallKeySpec {
             ("cage_mass", self.cage_mass),
             ("window_axial_width", self.window_axial_width),
             ("window_length", self.window_length),
-            ("bend_limit_deg", self.bend_limit_deg),
-            ("stop_stiffness", self.stop_stiffness),
+            ("cage_length", self.cage_length),
+            ("mouth_offset", self.mouth_offset),
         ] {
             positive(&format!("pipe.ball_keys.{name}"), v)?;
         }
@@ -553,6 +628,26 @@ impl BallKeySpec {
                 "pipe.ball_keys.head_radius",
                 self.head_radius,
                 "needs head_radius < cage_inner_radius < cage_outer_radius < seat_radius",
+            ));
+        }
+        if self.mouth_offset >= self.seat_radius {
+            return Err(SceneError::new(
+                "pipe.ball_keys.mouth_offset",
+                self.mouth_offset,
+                format!(
+                    "must be smaller than seat_radius = {} m, or the seat has no mouth",
+                    self.seat_radius
+                ),
+            ));
+        }
+        if self.cage_length >= 2.0 * self.cage_inner_radius {
+            return Err(SceneError::new(
+                "pipe.ball_keys.cage_length",
+                self.cage_length,
+                format!(
+                    "must be shorter than the cage's inner diameter {} m, or the cage has no end openings",
+                    2.0 * self.cage_inner_radius
+                ),
             ));
         }
         Ok(())

@@ -113,6 +113,18 @@ const HINGES_COLUMNS: &[ColumnDef] = &[
         "N",
         "friction force magnitude between cage and ball seat",
     ),
+    col(
+        "neck_normal",
+        F64,
+        "N",
+        "normal force of the head's neck on the seat's mouth, the articulation limit (0 below it)",
+    ),
+    col(
+        "neck_tangential",
+        F64,
+        "N",
+        "friction force magnitude between the head's neck and the seat's mouth",
+    ),
 ];
 
 /// Columns of the `keys` table (drill pipe): one row per ball key per frame.
@@ -410,6 +422,7 @@ fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
         let bend = angle_between(&axis(f, layout.chain[h]), &axis(f, layout.chain[h + 1]));
         let (hn, ht) = contact_totals(f.contacts, hinge.cage_head.as_slice());
         let (sn, st) = contact_totals(f.contacts, hinge.cage_seat.as_slice());
+        let (nn, nt) = contact_totals(f.contacts, hinge.neck.as_slice());
         table.push(&[
             step,
             t,
@@ -419,6 +432,8 @@ fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
             Cell::F64(ht),
             Cell::F64(sn),
             Cell::F64(st),
+            Cell::F64(nn),
+            Cell::F64(nt),
         ]);
     }
 }

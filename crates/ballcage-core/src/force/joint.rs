@@ -3,7 +3,8 @@
 //! The ideal constant-velocity (CV) joint keeps the two hinge points together
 //! with a stiff spring-damper, forbids relative twist about the body x axes
 //! (a CV joint passes spin through unchanged) with a torsional spring-damper,
-//! and limits the bend with a stop. Zero twist in the swing–twist
+//! and lets the bend free: an articulation limit is a contact between the
+//! surfaces that bind, not a joint term. Zero twist in the swing–twist
 //! decomposition of the relative rotation is exactly the CV condition: a head
 //! spun by φ about its axis and a seat spun by φ about its own give a relative
 //! rotation about an axis perpendicular to x.
@@ -21,10 +22,6 @@ pub struct CvJointParams {
     pub twist_stiffness: f64,
     /// Twist damper [N·m·s/rad].
     pub twist_damping: f64,
-    /// Bend beyond which the stop acts [rad].
-    pub bend_limit: f64,
-    /// Stop spring [N·m/rad].
-    pub stop_stiffness: f64,
 }
 
 /// Wrench of a joint on body b (body a gets the opposite force at its own
@@ -33,7 +30,7 @@ pub struct CvJointParams {
 pub struct JointWrench {
     /// Force on b at its hinge point [N], world frame.
     pub force: Vec3,
-    /// Pure torque on b [N·m], world frame (twist and stop).
+    /// Pure torque on b [N·m], world frame (twist).
     pub torque: Vec3,
     /// Twist angle [rad].
     pub twist: f64,
@@ -55,11 +52,9 @@ pub fn twist_axis(qa: &Quat, qb: &Quat) -> Vec3 {
     (ea + eb).try_normalize(1e-12).unwrap_or(ea)
 }
 
-/// Bend β between the two body x axes [rad], and the unit axis of
-/// e_a × e_b about which the bend opens (`None` when the axes are parallel).
-pub fn bend(qa: &Quat, qb: &Quat) -> (f64, Option<Vec3>) {
-    let (ea, eb) = (qa * Vec3::x(), qb * Vec3::x());
-    (angle_between(&ea, &eb), ea.cross(&eb).try_normalize(1e-12))
+/// Bend β between the two body x axes [rad].
+pub fn bend(qa: &Quat, qb: &Quat) -> f64 {
+    angle_between(&(qa * Vec3::x()), &(qb * Vec3::x()))
 }
 
 /// Wrench of a CV joint. `pa`, `pb`: hinge points [m]; `va`, `vb`: their
@@ -79,18 +74,12 @@ pub fn cv_joint_wrench(
     let force = -p.stiffness * (pb - pa) - p.damping * (vb - va);
     let axis = twist_axis(qa, qb);
     let twist = twist_angle(qa, qb);
-    let mut torque = -(p.twist_stiffness * twist + p.twist_damping * (wb - wa).dot(&axis)) * axis;
-    let (bend, opening) = bend(qa, qb);
-    if bend > p.bend_limit
-        && let Some(u) = opening
-    {
-        torque -= p.stop_stiffness * (bend - p.bend_limit) * u;
-    }
+    let torque = -(p.twist_stiffness * twist + p.twist_damping * (wb - wa).dot(&axis)) * axis;
     JointWrench {
         force,
         torque,
         twist,
-        bend,
+        bend: bend(qa, qb),
     }
 }
 
@@ -112,29 +101,5 @@ mod tests {
                 assert!((twist_angle(&qa, &(qb * extra)) - 0.01).abs() < 1e-12);
             }
         }
-    }
-
-    #[test]
-    fn the_stop_pushes_back_only_beyond_the_limit() {
-        let p = CvJointParams {
-            stiffness: 0.0,
-            damping: 0.0,
-            twist_stiffness: 0.0,
-            twist_damping: 0.0,
-            bend_limit: 0.1,
-            stop_stiffness: 100.0,
-        };
-        let z = Vec3::zeros();
-        let qa = Quat::identity();
-        let inside = Quat::from_axis_angle(&Vec3::z_axis(), 0.05);
-        let w = cv_joint_wrench(&qa, &inside, &z, &z, &z, &z, &z, &z, &p);
-        assert_eq!(w.torque, Vec3::zeros());
-        let beyond = Quat::from_axis_angle(&Vec3::z_axis(), 0.15);
-        let w = cv_joint_wrench(&qa, &beyond, &z, &z, &z, &z, &z, &z, &p);
-        assert!(
-            (w.torque - Vec3::new(0.0, 0.0, -5.0)).norm() < 1e-9,
-            "{}",
-            w.torque
-        );
     }
 }

@@ -15,9 +15,13 @@
 //! | cuboid–half-space | analytic: each vertex below the plane is a point |
 //! | cylinder–tube | analytic line contact (`line.rs`): one point per contact patch at its deepest penetration; `points` samples along the axis locate the patches |
 //! | ball–tube | analytic: distance to the centreline |
+//! | declared features (groove flank, window, spherical cavity, ring–cylinder) | analytic, in the bodies' frames (`ring.rs` for a neck through a ring) |
 
 mod line;
+mod ring;
 mod tube;
+
+pub use ring::RingCylinder;
 
 pub use tube::{CentrelinePoint, TubePath, TubeSegment};
 
@@ -139,6 +143,8 @@ pub enum PairGeometry {
         /// Sphere radius [m].
         sphere_radius: f64,
     },
+    /// Cylinder on body b through a ring of body a (a neck through an opening).
+    RingCylinder(RingCylinder),
 }
 
 impl PairGeometry {
@@ -185,6 +191,7 @@ impl PairGeometry {
                 sphere_radius,
                 ..
             } => cavity_radius.min(sphere_radius),
+            Self::RingCylinder(r) => r.cylinder_radius,
             _ => s1.radius().min(s2.radius()),
         }
     }
@@ -196,7 +203,8 @@ impl PairGeometry {
             | Self::BallTube
             | Self::TorusBall { .. }
             | Self::SlotBall { .. }
-            | Self::CavitySphere { .. } => 1,
+            | Self::CavitySphere { .. }
+            | Self::RingCylinder(_) => 1,
             Self::CuboidHalfSpace => 8,
             Self::CylinderTube { points } => points as usize,
         }
@@ -270,6 +278,7 @@ impl PairGeometry {
                 let ob = p2.0 + p2.1 * sphere_centre;
                 cavity_sphere(&oa, cavity_radius, &ob, sphere_radius, out)
             }
+            (Self::RingCylinder(r), _, _) => r.contacts(p1, p2, out),
             _ => {}
         }
     }

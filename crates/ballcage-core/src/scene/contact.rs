@@ -297,6 +297,23 @@ pub enum FeatureSpec {
         /// Sphere radius [m], smaller than the cavity's.
         sphere_radius: f64,
     },
+    /// A cylinder of body b through a ring of body a (a shaft's neck through
+    /// an opening): δ = cylinder_radius − d, d the distance from the ring to
+    /// the cylinder's axis at the ring point nearest the axis.
+    RingCylinder {
+        /// Ring centre, body a frame.
+        ring_centre: [f64; 3],
+        /// Normal of the ring's plane, body a frame.
+        ring_axis: [f64; 3],
+        /// Ring radius [m].
+        ring_radius: f64,
+        /// A point of the cylinder's axis, body b frame.
+        axis_point: [f64; 3],
+        /// Direction of the cylinder's axis, body b frame.
+        axis_direction: [f64; 3],
+        /// Cylinder radius [m], smaller than the ring's.
+        cylinder_radius: f64,
+    },
 }
 
 impl FeatureSpec {
@@ -339,6 +356,32 @@ impl FeatureSpec {
                         format!("{g}.sphere_radius"),
                         sphere_radius,
                         format!("must be smaller than cavity_radius = {cavity_radius}"),
+                    ));
+                }
+                Ok(())
+            }
+            Self::RingCylinder {
+                ring_centre,
+                ring_axis,
+                ring_radius,
+                axis_point,
+                axis_direction,
+                cylinder_radius,
+            } => {
+                finite_vec(&format!("{g}.ring_centre"), ring_centre)?;
+                direction(&format!("{g}.ring_axis"), ring_axis)?;
+                finite_vec(&format!("{g}.axis_point"), axis_point)?;
+                direction(&format!("{g}.axis_direction"), axis_direction)?;
+                positive(&format!("{g}.ring_radius"), *ring_radius)?;
+                positive(&format!("{g}.cylinder_radius"), *cylinder_radius)?;
+                if cylinder_radius >= ring_radius {
+                    return Err(SceneError::new(
+                        format!("{g}.cylinder_radius"),
+                        cylinder_radius,
+                        format!(
+                            "must be smaller than ring_radius = {ring_radius}: \
+                             a wider cylinder cannot pass through the ring"
+                        ),
                     ));
                 }
                 Ok(())

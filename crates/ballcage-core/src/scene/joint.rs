@@ -10,8 +10,9 @@ use crate::error::SceneError;
 #[serde(tag = "type", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum JointSpec {
     /// Ideal constant-velocity joint: the hinge points coincide (spring-damper),
-    /// no relative twist about the bodies' x axes (torsional spring-damper),
-    /// bend limited by a stop.
+    /// no relative twist about the bodies' x axes (torsional spring-damper).
+    /// It bends freely: an articulation limit is a contact between the
+    /// surfaces that bind (e.g. a `ring-cylinder` contact geometry).
     Cv {
         /// Name in messages.
         #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -28,23 +29,6 @@ pub enum JointSpec {
         twist_stiffness: f64,
         /// Twist damper [N·m·s/rad].
         twist_damping: f64,
-        /// Bend at which the stop engages [deg].
-        bend_limit_deg: f64,
-        /// Stop spring [N·m/rad].
-        stop_stiffness: f64,
-    },
-    /// Articulation stop only: a restoring torque `stop_stiffness·(β − limit)`
-    /// once the angle β between the bodies' x axes exceeds the limit.
-    BendStop {
-        /// Name in messages.
-        #[serde(default, skip_serializing_if = "Option::is_none")]
-        name: Option<String>,
-        /// The two bodies `[a, b]`.
-        bodies: [String; 2],
-        /// Bend at which the stop engages [deg].
-        bend_limit_deg: f64,
-        /// Stop spring [N·m/rad].
-        stop_stiffness: f64,
     },
 }
 
@@ -52,7 +36,7 @@ impl JointSpec {
     /// The two bodies `[a, b]`.
     pub fn bodies(&self) -> &[String; 2] {
         match self {
-            Self::Cv { bodies, .. } | Self::BendStop { bodies, .. } => bodies,
+            Self::Cv { bodies, .. } => bodies,
         }
     }
 
@@ -84,8 +68,6 @@ impl JointSpec {
                 damping,
                 twist_stiffness,
                 twist_damping,
-                bend_limit_deg,
-                stop_stiffness,
                 ..
             } => {
                 for (k, a) in anchors.iter().enumerate() {
@@ -95,16 +77,6 @@ impl JointSpec {
                 non_negative(&format!("{path}.damping"), *damping)?;
                 positive(&format!("{path}.twist_stiffness"), *twist_stiffness)?;
                 non_negative(&format!("{path}.twist_damping"), *twist_damping)?;
-                positive(&format!("{path}.bend_limit_deg"), *bend_limit_deg)?;
-                positive(&format!("{path}.stop_stiffness"), *stop_stiffness)?;
-            }
-            Self::BendStop {
-                bend_limit_deg,
-                stop_stiffness,
-                ..
-            } => {
-                positive(&format!("{path}.bend_limit_deg"), *bend_limit_deg)?;
-                positive(&format!("{path}.stop_stiffness"), *stop_stiffness)?;
             }
         }
         Ok(())

@@ -574,10 +574,17 @@ pub(crate) fn deserialize_with_path<T: serde::de::DeserializeOwned>(
     })
 }
 
-/// Parses TOML text into a table; a syntax error names its line.
+/// Parses TOML text into a table. A syntax error names no field (`path`
+/// is empty) and says where it is: "TOML syntax error at line 2, column 7:
+/// <reason>" (both counted from 1, the column in characters).
 pub(crate) fn parse_toml(text: &str) -> Result<toml::Table, SceneError> {
     text.parse().map_err(|e: toml::de::Error| {
-        SceneError::new(toml_error_path(&e, text), "", first_line(e.message()))
+        let reason = first_line(e.message());
+        SceneError::new(
+            "",
+            "",
+            format!("TOML syntax error{}: {reason}", toml_error_place(&e, text)),
+        )
     })
 }
 
@@ -606,14 +613,21 @@ fn first_line(s: &str) -> String {
     s.lines().next().unwrap_or("").trim().to_string()
 }
 
-fn toml_error_path(e: &toml::de::Error, text: &str) -> String {
-    match e.span() {
-        Some(span) => {
-            let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
-            format!("<toml line {line}>")
-        }
-        None => "<toml>".to_string(),
+/// " at line L, column C" of a syntax error (1-based; the column counts
+/// characters), or nothing when the parser gives no position.
+fn toml_error_place(e: &toml::de::Error, text: &str) -> String {
+    let Some(span) = e.span() else {
+        return String::new();
+    };
+    let mut start = span.start.min(text.len());
+    while !text.is_char_boundary(start) {
+        start -= 1;
     }
+    let before = &text[..start];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let column = before[line_start..].chars().count() + 1;
+    format!(" at line {line}, column {column}")
 }
 
 /// Rejects non-finite and non-positive values.

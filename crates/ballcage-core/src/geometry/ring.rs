@@ -1,0 +1,192 @@
+//! A cylinder passing through a circular opening: a shaft's neck through the
+//! end ring of a cage or the mouth of a seat, the surfaces that bind when a
+//! joint articulates as far as it can.
+//!
+//! The cylinder (radius r, axis through P along â) touches the ring (centre O,
+//! plane normal ê, radius ρ) where the ring comes nearest the axis. With
+//! c(φ) = O + ρ(cos φ ê₁ + sin φ ê₂) and w = c − P, the squared distance from
+//! the ring point to the axis is g(φ) = |w|² − (w·â)²; the contact is at the
+//! minimiser φ*, with δ = r − √g(φ*).
+//!
+//! For an axis through the ring's axis at distance h from the ring's plane,
+//! tilted by t from ê, the nearest ring point lies in the plane of the tilt
+//! and √g = ρ·cos t − h·sin t (physics.md §3, docs/model.md §3): the
+//! closed form the tests check.
+
+use super::ContactPoint;
+use crate::math::{Quat, Vec3};
+
+/// The ring (on body a) and the cylinder (on body b) in their bodies' frames.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RingCylinder {
+    /// Ring centre, a's frame [m].
+    pub ring_centre: Vec3,
+    /// Unit normal of the ring's plane, a's frame.
+    pub ring_axis: Vec3,
+    /// Ring radius [m].
+    pub ring_radius: f64,
+    /// A point of the cylinder's axis, b's frame [m].
+    pub axis_point: Vec3,
+    /// Unit direction of the cylinder's axis, b's frame.
+    pub axis_direction: Vec3,
+    /// Cylinder radius [m], smaller than the ring's.
+    pub cylinder_radius: f64,
+}
+
+impl RingCylinder {
+    /// Appends the contact of the cylinder (body b) with the ring (body a),
+    /// if they overlap. The normal points from the ring toward the axis,
+    /// pushing the cylinder away from the ring.
+    pub fn contacts(&self, pa: (&Vec3, &Quat), pb: (&Vec3, &Quat), out: &mut Vec<ContactPoint>) {
+        let o = pa.0 + pa.1 * self.ring_centre;
+        let e = pa.1 * self.ring_axis;
+        let p = pb.0 + pb.1 * self.axis_point;
+        let a = pb.1 * self.axis_direction;
+        let (e1, e2) = plane_basis(&e);
+        let ring = |phi: f64| o + self.ring_radius * (phi.cos() * e1 + phi.sin() * e2);
+        let phi = nearest_to_axis(&o, &e1, &e2, self.ring_radius, &p, &a);
+        let c = ring(phi);
+        let w = c - p;
+        let foot = p + w.dot(&a) * a;
+        let to_axis = foot - c;
+        let d = to_axis.norm();
+        let depth = self.cylinder_radius - d;
+        if depth <= 0.0 || d < 1e-15 {
+            return;
+        }
+        let normal = to_axis / d;
+        out.push(ContactPoint {
+            slot: 0,
+            point: c - 0.5 * depth * normal,
+            normal,
+            depth,
+        });
+    }
+}
+
+/// Two unit vectors completing `e` to a right-handed orthonormal basis.
+fn plane_basis(e: &Vec3) -> (Vec3, Vec3) {
+    let helper = if e.x.abs() < 0.9 {
+        Vec3::x()
+    } else {
+        Vec3::y()
+    };
+    let e1 = e.cross(&helper).normalize();
+    (e1, e.cross(&e1))
+}
+
+/// The ring angle φ* whose point is nearest the axis (P, â): Newton on
+/// g′(φ) = 0 from the best of 12 samples, so that the start lies in the
+/// basin of the global minimum.
+fn nearest_to_axis(o: &Vec3, e1: &Vec3, e2: &Vec3, rho: f64, p: &Vec3, a: &Vec3) -> f64 {
+    let g = |phi: f64| {
+        let w = o + rho * (phi.cos() * e1 + phi.sin() * e2) - p;
+        w.norm_squared() - w.dot(a).powi(2)
+    };
+    let mut phi = (0..12)
+        .map(|k| k as f64 * std::f64::consts::TAU / 12.0)
+        .min_by(|x, y| g(*x).total_cmp(&g(*y)))
+        .unwrap_or(0.0);
+    for _ in 0..20 {
+        let (s, c) = phi.sin_cos();
+        let w = o + rho * (c * e1 + s * e2) - p;
+        let dc = rho * (-s * e1 + c * e2);
+        let ddc = -rho * (c * e1 + s * e2);
+        let (wa, da) = (w.dot(a), dc.dot(a));
+        let g1 = 2.0 * (w.dot(&dc) - wa * da);
+        let g2 = 2.0 * (dc.norm_squared() + w.dot(&ddc) - da * da - wa * ddc.dot(a));
+        if g2 <= 0.0 {
+            break;
+        }
+        let step = g1 / g2;
+        phi -= step;
+        if step.abs() < 1e-14 {
+            break;
+        }
+    }
+    phi
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    /// A ring of radius ρ at height h on the z axis; the cylinder's axis
+    /// through the origin, tilted by t toward +x about y.
+    fn touch(rho: f64, h: f64, r: f64, t: f64, spin: f64) -> Option<ContactPoint> {
+        let g = RingCylinder {
+            ring_centre: Vec3::new(0.0, 0.0, h),
+            ring_axis: Vec3::z(),
+            ring_radius: rho,
+            axis_point: Vec3::zeros(),
+            axis_direction: Vec3::z(),
+            cylinder_radius: r,
+        };
+        let tilt = Quat::from_axis_angle(&Vec3::y_axis(), t);
+        let about = Quat::from_axis_angle(&Vec3::z_axis(), spin);
+        let mut out = vec![];
+        g.contacts(
+            (&Vec3::zeros(), &about),
+            (&Vec3::zeros(), &(about * tilt)),
+            &mut out,
+        );
+        out.first().copied()
+    }
+
+    #[test]
+    fn a_tilted_neck_touches_the_ring_where_the_closed_form_says() {
+        let (rho, h, r) = (0.0237, 0.020, 0.021);
+        for deg in [2.0f64, 5.0, 7.5, 10.0] {
+            for spin in [0.0, 1.0, 2.5] {
+                let t = deg.to_radians();
+                let closed = r - (rho * t.cos() - h * t.sin());
+                match touch(rho, h, r, t, spin) {
+                    Some(c) => {
+                        assert_relative_eq!(c.depth, closed, epsilon = 1e-12);
+                        // The ring point on the side the neck tilts toward,
+                        // pushing the neck back toward the ring's axis.
+                        let toward = Quat::from_axis_angle(&Vec3::z_axis(), spin) * Vec3::x();
+                        assert!(c.normal.dot(&toward) < -0.9, "{:?}", c.normal);
+                    }
+                    None => assert!(closed <= 0.0, "missed a contact of {closed} m at {deg}°"),
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_contact_starts_at_the_angle_where_the_neck_meets_the_ring() {
+        // ρ cos t − h sin t = r  ⇔  t = acos(r/R) − asin(h/R), R = √(ρ² + h²).
+        let (rho, h, r): (f64, f64, f64) = (0.0237, 0.020, 0.021);
+        let big_r = (rho * rho + h * h).sqrt();
+        let t0 = (r / big_r).acos() - (h / big_r).asin();
+        assert!(touch(rho, h, r, t0 - 1e-4, 0.3).is_none());
+        let c = touch(rho, h, r, t0 + 1e-4, 0.3).expect("in contact past the limit");
+        assert!(c.depth > 0.0 && c.depth < 1e-5);
+    }
+
+    #[test]
+    fn an_offset_axis_is_measured_exactly() {
+        // Axis parallel to the ring's, offset by e toward +x: the nearest ring
+        // point is at +x, at distance ρ − e.
+        let g = RingCylinder {
+            ring_centre: Vec3::zeros(),
+            ring_axis: Vec3::z(),
+            ring_radius: 0.03,
+            axis_point: Vec3::new(0.0, 0.0, 0.0),
+            axis_direction: Vec3::z(),
+            cylinder_radius: 0.025,
+        };
+        let mut out = vec![];
+        let pb = Vec3::new(0.007, 0.0, 0.5);
+        g.contacts(
+            (&Vec3::zeros(), &Quat::identity()),
+            (&pb, &Quat::identity()),
+            &mut out,
+        );
+        assert_eq!(out.len(), 1);
+        assert_relative_eq!(out[0].depth, 0.025 - (0.03 - 0.007), epsilon = 1e-12);
+        assert_relative_eq!(out[0].normal, -Vec3::x(), epsilon = 1e-9);
+    }
+}

@@ -1,0 +1,370 @@
+"""Torque buckling of a chain of constant-velocity hinges: when it leaves the arc (docs/buckling.md).
+
+A hinge bent by β that passes a torque T puts a couple T·tan(β/2) across each
+of its shafts. On an arc whose bends are equal these couples are carried by a
+constant out-of-plane hinge shear; where two bends around a hinge differ (at
+the connectors, which sit tangent to the tube while the links are chords),
+hinge k needs an out-of-plane force
+
+    W_k = T·D_k / l,   D_k = tan(β_{k+1}/2) − tan(β_{k−1}/2)
+
+from the wall (docs/buckling.md §2). Nothing in an ideal CV chain resists it:
+the torque is its only load, so its shape does not depend on T and it leaves
+the arc at any torque. `buckling` gives the torque at which the hinge with the
+largest such drive swings 1 rad about the chord of its neighbours against
+what can hold it (§3): gravity on its two links (a pendulum), a joint bending
+stiffness and a hinge friction moment, and, for longer chains, the discrete
+Greenhill torque of a bending stiffness with axial tension. Everything is SI:
+torques in N·m, forces in N, lengths in m, stiffness in N·m/rad.
+
+    >>> import ballcage
+    >>> b = ballcage.buckling()                        # the paper's scene
+    >>> round(b.threshold)                             # N·m, held by gravity alone
+    62
+    >>> ballcage.buckling(bending_stiffness=3400.0).threshold > 1800.0
+    True
+
+``ballcage buckling`` prints the same from the command line, and with
+``--simulate`` checks it against three quasi-static runs (`simulate_check`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ballcage import _native
+from ballcage.scene import SceneSource, default_scene, load_scene
+
+if TYPE_CHECKING:
+    import argparse
+
+__all__ = ["Buckling", "HingeDrive", "SimulatedTorque", "buckling", "end_wall_force", "simulate_check"]
+
+#: Swing about the chord of its neighbours [rad] at which a hinge counts as having left the arc.
+LEFT_AT_SWING = 1.0
+#: |D_k| below which a hinge has no first-order drive (its two neighbouring bends are equal).
+NO_DRIVE = 1e-12
+
+
+@dataclass(frozen=True)
+class HingeDrive:
+    """One free hinge of the chain placed on the tube's centreline (docs/buckling.md §2–3)."""
+
+    #: Hinge number, 0 between the upper connector and link 1.
+    hinge: int
+    #: D_k = tan(β_{k+1}/2) − tan(β_{k−1}/2) [1]: the wall force W_k = T·D_k/l that holds it on the arc.
+    imbalance: float
+    #: Distance of the hinge from the chord of its two neighbours [m]: the radius it swings on.
+    swing_radius: float
+    #: Gravity across that chord [m/s²]: what the hinge's pendulum hangs in.
+    gravity_across: float
+    #: Torque [N·m] at which this hinge swings `LEFT_AT_SWING` rad; ``inf`` without drive.
+    threshold: float
+
+
+@dataclass(frozen=True)
+class Buckling:
+    """What `buckling` found: the threshold torque and every term it used (SI)."""
+
+    #: Torque [N·m] above which the chain leaves the arc; 0 when nothing holds it.
+    threshold: float
+    #: Which mode sets it: ``"hinge k"`` (a hinge pushed off the arc) or ``"Greenhill"``.
+    mode: str
+    #: Per free hinge (1 … n−1), the drive and the hinge's own threshold.
+    hinges: tuple[HingeDrive, ...]
+    #: Discrete Greenhill torque [N·m] of the stiffness and tension terms; ``inf`` when neither is given.
+    greenhill: float
+    #: Bend of every hinge on the placed chain [rad], 0 … n.
+    bends: tuple[float, ...]
+    #: The terms, SI with the unit in the key.
+    terms: dict[str, float] = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        rows = [f"threshold torque          {self.threshold:12.4g} N·m  ({self.mode})"]
+        rows += [f"{k:<26}{v:12.4g}" for k, v in self.terms.items()]
+        rows.append(f"Greenhill torque          {self.greenhill:12.4g} N·m")
+        rows.append("hinge  bend [deg]  D_k [1]     W_k/T [1/m]  swing radius [mm]  g across [m/s²]  T_c [N·m]")
+        pitch = self.terms["pitch [m]"]
+        for h in self.hinges:
+            rows.append(
+                f"{h.hinge:5d}  {math.degrees(self.bends[h.hinge]):10.3f}  {h.imbalance:+.5f}  "
+                f"{h.imbalance / pitch:+11.5f}  {1e3 * h.swing_radius:17.3f}  {h.gravity_across:15.3f}  "
+                f"{h.threshold:9.4g}"
+            )
+        return "\n".join(rows)
+
+
+def end_wall_force(torque: float, bends: Sequence[float], pitch: float) -> list[float]:
+    """Out-of-plane wall force [N] each free hinge 1 … n−1 needs to stay on a planar placed chain.
+
+    ``W_k = T·(tan(β_{k+1}/2) − tan(β_{k−1}/2))/l`` for `torque` T [N·m], `bends` β_0 … β_n [rad]
+    and hinge `pitch` l [m] (docs/buckling.md §2, eq. 2.4); the sign is the side it pushes toward.
+    """
+    if not pitch > 0.0:
+        raise ValueError(f"pitch = {pitch} m: must be positive (the hinge-to-hinge length)")
+    half = [math.tan(b / 2.0) for b in bends]
+    return [torque * (half[k + 1] - half[k - 1]) / pitch for k in range(1, len(bends) - 1)]
+
+
+def buckling(
+    scene: SceneSource | None = None,
+    *,
+    friction_moment: float = 0.0,
+    bending_stiffness: float = 0.0,
+    axial_tension: float = 0.0,
+    overrides: Iterable[str] = (),
+) -> Buckling:
+    """The torque [N·m] above which a drill-pipe scene's chain leaves the arc of its tube.
+
+    `scene` is anything `ballcage.load_scene` takes (default: the paper's scene) and
+    `overrides` ``dotted.key=value`` strings. The stabilising terms the scene does not
+    model are given here: `friction_moment` M_f [N·m], a static friction moment each
+    hinge opposes to bending; `bending_stiffness` k_b [N·m/rad] of each hinge;
+    `axial_tension` N [N] along the chain (compression negative). Gravity and the
+    link mass come from the scene. Raises `ValueError` naming a bad term or a scene
+    that is not a drill pipe, and `ballcage.SceneError` for an invalid scene.
+    """
+    _check_terms(friction_moment, bending_stiffness, axial_tension)
+    patches = list(overrides)
+    s = default_scene(patches) if scene is None else load_scene(scene, patches)
+    if s.kind != "drill-pipe":
+        raise ValueError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
+    pitch, n = float(s.value("pipe.pitch")), int(s.value("pipe.joints"))
+    mass, gravity = _link_mass(s), float(s.value("world.gravity"))
+    points, tangents = _placed_chain(
+        float(s.value("borehole.curvature_radius")), math.radians(float(s.value("borehole.build_angle_deg"))), pitch, n
+    )
+    bends = tuple(math.acos(max(-1.0, min(1.0, _dot(a, b)))) for a, b in zip(tangents, tangents[1:], strict=False))
+    hinges = tuple(
+        _hinge_drive(k, points, bends, mass, gravity, pitch, friction_moment, bending_stiffness) for k in range(1, n)
+    )
+    greenhill = _greenhill(n, pitch, bending_stiffness, axial_tension)
+    weakest = min(hinges, key=lambda h: h.threshold, default=None)
+    threshold, mode = (weakest.threshold, f"hinge {weakest.hinge}") if weakest else (math.inf, "none")
+    if greenhill < threshold:
+        threshold, mode = greenhill, "Greenhill"
+    terms = {
+        "pitch [m]": pitch,
+        "links": float(n),
+        "link mass [kg]": mass,
+        "gravity [m/s^2]": gravity,
+        "tube clearance [m]": (float(s.value("borehole.inner_diameter")) - float(s.value("pipe.link_diameter"))) / 2,
+        "friction moment [N·m]": friction_moment,
+        "bending stiffness [N·m/rad]": bending_stiffness,
+        "axial tension [N]": axial_tension,
+    }
+    return Buckling(threshold, mode, hinges, greenhill, bends, terms)
+
+
+@dataclass(frozen=True)
+class SimulatedTorque:
+    """One quasi-static run of `simulate_check`: what the chain did at one torque (SI)."""
+
+    #: Resisting moment of the run [N·m].
+    torque: float
+    #: Mean over hinges 0 … n of the bend [deg], averaged over the settled window.
+    mean_bend_deg: float
+    #: Largest hinge bend [deg] in the settled window.
+    max_bend_deg: float
+    #: Sum over links of the mean link–tube normal force [N].
+    wall_force: float
+    #: Largest mean offset of a link's centre from the bend plane [m].
+    lateral_offset: float
+
+
+def simulate_check(
+    scene: SceneSource | None = None,
+    torques: Sequence[float] = (),
+    *,
+    overrides: Iterable[str] = (),
+    duration: float = 1.0,
+    ramp: float = 0.3,
+    window: float = 0.2,
+) -> list[SimulatedTorque]:
+    """Runs the scene held still (``drive.speed_rpm = 0``) at each of `torques` [N·m], ramped over `ramp` [s].
+
+    Each run lasts `duration` [s]; bends, wall forces and lateral offsets are averaged
+    over its last `window` [s] (docs/buckling.md §5). Raises `ValueError` for a bad
+    time and `ballcage.SimulationError` if a run diverges.
+    """
+    from ballcage.run import simulate  # deferred: pyarrow is only needed here
+
+    if not 0.0 < window < duration or not 0.0 <= ramp < duration - window:
+        raise ValueError(
+            f"duration = {duration} s, ramp = {ramp} s, window = {window} s: "
+            "need 0 < window and ramp + window < duration, so the window sees the full torque"
+        )
+    base = list(overrides) + [
+        "drive.speed_rpm=0",
+        f"load.ramp={ramp}",
+        f"simulation.duration={duration}",
+        "simulation.output_interval=0.01",
+        'record.tables=["links", "hinges"]',
+    ]
+    out = []
+    for torque in torques:
+        patches = base + [f"load.resisting_moment={float(torque)!r}"]
+        s = default_scene(patches) if scene is None else load_scene(scene, patches)
+        run = simulate(s, progress=False)
+        out.append(_observe(float(torque), run.tables["links"], run.tables["hinges"], duration - window))
+    return out
+
+
+def _observe(torque: float, links: Any, hinges: Any, since: float) -> SimulatedTorque:
+    """Averages the settled window (t > `since`) of the links and hinges tables."""
+
+    def settled(table: Any, key: str, value: str) -> dict[int, list[float]]:
+        rows: dict[int, list[float]] = {}
+        columns = (table.column(name).to_pylist() for name in ("t", key, value))
+        for t, k, v in zip(*columns, strict=True):
+            if t > since + 1e-9:
+                rows.setdefault(k, []).append(v)
+        return rows
+
+    def mean(v: list[float]) -> float:
+        return sum(v) / len(v)
+
+    bends = settled(hinges, "hinge", "bend_deg")
+    return SimulatedTorque(
+        torque=torque,
+        mean_bend_deg=mean([mean(v) for v in bends.values()]),
+        max_bend_deg=max(max(v) for v in bends.values()),
+        wall_force=sum(mean(v) for v in settled(links, "link", "tube_normal").values()),
+        lateral_offset=max(abs(mean(v)) for v in settled(links, "link", "offset_lateral").values()),
+    )
+
+
+def _check_terms(friction_moment: float, bending_stiffness: float, axial_tension: float) -> None:
+    resistances = (("friction_moment", friction_moment, "N·m"), ("bending_stiffness", bending_stiffness, "N·m/rad"))
+    for name, value, unit in resistances:
+        if not (math.isfinite(value) and value >= 0.0):
+            raise ValueError(f"{name} = {value} {unit}: must be a finite number ≥ 0 (a resistance, not a drive)")
+    if not math.isfinite(axial_tension):
+        raise ValueError(f"axial_tension = {axial_tension} N: must be finite (tension positive, compression negative)")
+
+
+def _link_mass(s: _native.Scene) -> float:
+    """Link mass [kg]; the ideal-CV model adds one hinge's cage and keys to each link (docs/model.md §3)."""
+    mass = float(s.value("pipe.link_mass"))
+    if s.value("pipe.hinge") == "ideal-cv":
+        mass += float(s.value("pipe.ball_keys.cage_mass")) + 6.0 * float(s.value("pipe.ball_keys.ball_mass"))
+    return mass
+
+
+def _centreline(radius: float, build: float, arc_length: float) -> tuple[float, float]:
+    """Point (x, z) [m] at `arc_length` along the tube centreline, straight past the arc (docs/model.md §4)."""
+    end = radius * build
+    if arc_length <= end:
+        a = arc_length / radius
+        return radius * (1.0 - math.cos(a)), -radius * math.sin(a)
+    x0, z0 = radius * (1.0 - math.cos(build)), -radius * math.sin(build)
+    return x0 + (arc_length - end) * math.sin(build), z0 - (arc_length - end) * math.cos(build)
+
+
+def _placed_chain(
+    radius: float, build: float, pitch: float, n: int
+) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
+    """Hinge points 0 … n on the centreline one pitch apart (chords), and the body axes 0 … n+1 (x, z)."""
+    points, s = [(0.0, 0.0)], 0.0
+    for _ in range(n):
+        lo, hi = s, s + 2.0 * pitch  # the chord to the next hinge is reached within two pitches of arc
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if _dist(_centreline(radius, build, mid), points[-1]) < pitch else (lo, mid)
+        s = 0.5 * (lo + hi)
+        points.append(_centreline(radius, build, s))
+    ahead = min(s, radius * build) / radius
+    tangents = [(0.0, -1.0)]
+    tangents += [((b[0] - a[0]) / pitch, (b[1] - a[1]) / pitch) for a, b in zip(points, points[1:], strict=False)]
+    tangents.append((math.sin(ahead), -math.cos(ahead)))
+    return points, tangents
+
+
+def _hinge_drive(
+    k: int,
+    points: Sequence[tuple[float, float]],
+    bends: Sequence[float],
+    mass: float,
+    gravity: float,
+    pitch: float,
+    friction_moment: float,
+    bending_stiffness: float,
+) -> HingeDrive:
+    """Hinge k's drive D_k and the torque that swings it 1 rad (docs/buckling.md eq. 3.4)."""
+    imbalance = math.tan(bends[k + 1] / 2.0) - math.tan(bends[k - 1] / 2.0)
+    a, h, b = points[k - 1], points[k], points[k + 1]
+    chord = ((b[0] - a[0]) / _dist(a, b), (b[1] - a[1]) / _dist(a, b))
+    rho = abs((h[0] - a[0]) * chord[1] - (h[1] - a[1]) * chord[0])
+    g_across = gravity * abs(chord[0])  # |g × chord| for g along −z
+    hold = mass * g_across * pitch + 6.0 * bending_stiffness * rho / pitch + 4.0 * friction_moment
+    threshold = LEFT_AT_SWING * hold / abs(imbalance) if abs(imbalance) > NO_DRIVE else math.inf
+    return HingeDrive(k, imbalance, rho, g_across, threshold)
+
+
+def _greenhill(n: int, pitch: float, stiffness: float, tension: float) -> float:
+    """Discrete Greenhill torque [N·m]: min over θ ∈ [2π/n, π) of (l·N + 4k_b·sin²(θ/2))/sin θ (eq. 3.7)."""
+    if n < 3 or (stiffness == 0.0 and tension == 0.0):
+        return math.inf
+    lowest = 2.0 * math.pi / n
+    thetas = [lowest + (math.pi - lowest) * i / 4000 for i in range(4000)]
+    return max(0.0, min((pitch * tension + 4.0 * stiffness * math.sin(t / 2.0) ** 2) / math.sin(t) for t in thetas))
+
+
+def _dist(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return math.hypot(b[0] - a[0], b[1] - a[1])
+
+
+def _dot(a: tuple[float, float], b: tuple[float, float]) -> float:
+    return a[0] * b[0] + a[1] * b[1]
+
+
+def add_command(commands: Any) -> None:
+    """Registers ``ballcage buckling`` on the CLI's subcommands (`ballcage.cli`)."""
+    parser = commands.add_parser(
+        "buckling",
+        help="torque above which a drill-pipe chain leaves the arc of its tube (docs/buckling.md)",
+        description=(
+            "Print the torque [N·m] above which the chain of a drill-pipe scene (default: the paper's) "
+            "leaves the arc of its tube, with every term used (SI). --simulate checks it against quasi-static "
+            "runs (drive held, torque ramped) at a fifth of, at, and five times the threshold."
+        ),
+    )
+    parser.add_argument("scene", nargs="?", help="scene TOML file (default: the embedded paper scene)")
+    parser.add_argument("--set", metavar="KEY=VALUE", action="append", default=[], dest="overrides",
+                        help="override a scene field, e.g. --set 'pipe.hinge=\"ideal-cv\"' --set pipe.joints=3")
+    for option, unit, what in (
+        ("--friction-moment", "N·m", "static friction moment each hinge opposes to bending"),
+        ("--bending-stiffness", "N·m/rad", "bending stiffness of each hinge"),
+        ("--axial-tension", "N", "axial tension along the chain (compression negative)"),
+    ):
+        parser.add_argument(option, type=float, default=0.0, metavar=unit, help=f"{what} [{unit}] (default 0)")
+    parser.add_argument("--simulate", action="store_true", help="also run the three-torque check (seconds to minutes)")
+    parser.set_defaults(command=_cli)
+
+
+def _cli(args: argparse.Namespace) -> int:
+    from ballcage.cli import UsageError, _load_cli_scene
+
+    scene = _load_cli_scene(args.scene, args.overrides)
+    try:
+        result = buckling(
+            scene,
+            friction_moment=args.friction_moment,
+            bending_stiffness=args.bending_stiffness,
+            axial_tension=args.axial_tension,
+        )
+    except ValueError as e:
+        raise UsageError(str(e)) from e
+    print(result)
+    if args.simulate:
+        if not 0.0 < result.threshold < math.inf:
+            raise UsageError(f"threshold = {result.threshold} N·m: --simulate needs a finite, positive threshold")
+        torques = [result.threshold / 5.0, result.threshold, 5.0 * result.threshold]
+        print("\ntorque [N·m]  mean bend [deg]  max bend [deg]  wall force [N]  lateral offset [mm]")
+        for r in simulate_check(scene, torques):
+            print(f"{r.torque:12.4g}  {r.mean_bend_deg:15.3f}  {r.max_bend_deg:14.3f}  {r.wall_force:14.4g}  "
+                  f"{1e3 * r.lateral_offset:19.3f}")
+    return 0
