@@ -9,8 +9,12 @@ from the hinges and links tables over 0.4 s to the end (after the drive and
 load ramps), then every quantity of the run's comparison.parquet that has a
 value. Shape rows: mean, 95th percentile and largest bend [deg] of hinges
 1–11 (between two links), the share of frames × hinges with the neck on the
-seat's mouth (hinges.neck_normal > 0), and the sum over links of the mean
-tube normal force [N].
+seat's mouth (hinges.neck_normal > 0) and the peak neck force, the sum over
+links and the largest of the per-link mean tube normal forces [N] (and at
+which link), the seat-race contact angle of the keys (median over loads above
+5 kN, and at the largest load), and how many h/16 part steps SDIRK2 took by
+its fallback (`ballcage.fallback_steps`). Ideal-CV runs have no keys table
+and get no key rows.
 """
 
 from __future__ import annotations
@@ -37,7 +41,18 @@ def shape_rows(folder: Path) -> dict[str, float]:
     links = _window(pq.read_table(folder / "links.parquet"))
     link = links["link"].to_numpy()
     normal = links["tube_normal"].to_numpy()
-    tube_sum = sum(normal[link == k].mean() for k in np.unique(link))
+    means = {int(k): float(normal[link == k].mean()) for k in np.unique(link)}
+    tube_sum = sum(means.values())
+    busiest = max(means, key=means.get)
+    keys = _window(pq.read_table(folder / "keys.parquet")) if (folder / "keys.parquet").is_file() else None
+    rows_keys = keys is not None and keys.num_rows > 0
+    force = keys["outer_normal"].to_numpy() if rows_keys else np.zeros(1)
+    angle = (
+        keys["outer_contact_angle_deg"].to_numpy(zero_copy_only=False).astype(float) if rows_keys else np.full(1, np.nan)
+    )
+    loaded = (force > 5000.0) & np.isfinite(angle)
+    meta = pq.read_schema(folder / "links.parquet").metadata or {}
+    fallbacks = int(meta.get(b"ballcage.fallback_steps", b"0"))
     return {
         "mean bend, hinges 1–11 [deg]": float(bend.mean()),
         "95th percentile bend [deg]": float(np.percentile(bend, 95)),
@@ -45,6 +60,13 @@ def shape_rows(folder: Path) -> dict[str, float]:
         "neck on the mouth [% of hinge-frames]": 100.0 * float((neck > 0).mean()),
         "peak neck force [N]": float(neck.max()),
         "sum of per-link mean tube forces [N]": float(tube_sum),
+        "largest per-link mean tube force [N]": means[busiest],
+        "link with the largest mean tube force": float(busiest),
+        "seat-race contact angle, median over keys above 5 kN [deg]": float(np.median(angle[loaded]))
+        if loaded.any()
+        else float("nan"),
+        "seat-race contact angle at the largest seat-key force [deg]": float(angle[np.argmax(force)]),
+        "SDIRK2 part steps taken by the fallback": float(fallbacks),
     }
 
 
@@ -64,7 +86,8 @@ def main(argv: list[str]) -> int:
     print("| quantity | paper | " + " | ".join(labels) + " |")
     print("|---|---:|" + "---:|" * len(labels))
     for key in next(iter(shapes.values())):
-        print(f"| {key} | | " + " | ".join(f"{shapes[lab][key]:.4g}" for lab in labels) + " |")
+        cells = ["" if not np.isfinite(shapes[lab][key]) else f"{shapes[lab][key]:.4g}" for lab in labels]
+        print(f"| {key} | | " + " | ".join(cells) + " |")
     keys = [k for k in comparisons[labels[0]]]
     for key in keys:
         unit, paper = comparisons[labels[0]][key][1], comparisons[labels[0]][key][2]

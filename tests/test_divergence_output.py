@@ -192,9 +192,16 @@ def test_a_step_too_large_still_gets_the_step_advice_which_holds():
 
 def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
     # One Newton iteration per stage cannot converge, however small the step: SDIRK2 halves the
-    # step four times and gives up; the message says the step is not the cause.
+    # step four times and, without its fallback to linearly implicit Euler, gives up; the message
+    # says the step is not the cause.
     scene = default_scene(
-        ["pipe.joints=2", "simulation.duration=0.01", "simulation.dt=1e-3", "simulation.newton.max_iterations=1"]
+        [
+            "pipe.joints=2",
+            "simulation.duration=0.01",
+            "simulation.dt=1e-3",
+            "simulation.newton.max_iterations=1",
+            "simulation.newton.fallback=false",
+        ]
     )
     with pytest.raises(ballcage.SimulationError) as info:
         ballcage.simulate(scene)

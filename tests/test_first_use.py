@@ -46,6 +46,8 @@ def test_run_records_the_engineering_tables_of_a_drill_pipe_by_default(tmp_path)
     # The written scene says what was recorded, so it reruns the same.
     scene = tomllib.loads((out / "scene.toml").read_text(encoding="utf-8"))
     assert set(scene["record"]["tables"]) == _tables(out)
+    # The default is the scene's, so Python records the same.
+    assert set(ballcage.load_scene({"kind": "drill-pipe"}).table_names) == _tables(out)
 
 
 def test_tables_option_chooses_the_tables(tmp_path):
@@ -101,7 +103,7 @@ def test_run_help_says_how_to_choose_tables():
     assert proc.returncode == 0
     text = " ".join(proc.stdout.split())
     assert "--tables NAME,..." in text
-    assert "links,hinges,keys,drive,summary,pairs" in text
+    assert "links, hinges, keys, drive, summary and pairs" in text
     assert ", ".join(_native.TABLE_NAMES) in text
 
 

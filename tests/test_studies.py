@@ -344,11 +344,12 @@ def test_stability_heat_maps_are_written(slot_stability, tmp_path):
 
 
 def test_tightest_radius_is_the_articulation_limit_over_the_pitch():
-    # The neck (r = 21 mm) meets the cage rim (R_ci = 31 mm, cut at ±20 mm)
-    # at β = 2·(acos(21/31) − asin(20/31)); on an arc R = p / (2 sin(β/2)).
-    beta = 2 * (math.acos(21 / 31) - math.asin(20 / 31))
+    # The neck (r = 19 mm) meets the seat's mouth (the seat sphere, R_s = 32.01 mm, cut 20 mm
+    # from the hinge centre) at β = acos(19/32.01) − asin(20/32.01) = 14.92°; on an arc
+    # R = p / (2 sin(β/2)).
+    beta = math.acos(19 / 32.01) - math.asin(20 / 32.01)
     assert studies.tightest_radius() == pytest.approx(0.2 / (2 * math.sin(beta / 2)), rel=1e-12)
-    assert studies.tightest_radius() == pytest.approx(0.800, abs=1e-3)
+    assert studies.tightest_radius() == pytest.approx(0.770, abs=1e-3)
 
 
 def test_tightest_radius_is_eq9_without_an_articulation_limit():

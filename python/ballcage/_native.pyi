@@ -132,6 +132,14 @@ class Scene:
         point, a list of floats. Raises `SceneError` for a generic scene.
         """
 
+    def placed_chain(self) -> dict[str, Any]:
+        """The drill pipe's chain as placed at t = 0 (docs/model.md §4, Option A).
+
+        Keys ``"hinges"``: hinge centres 0 … n [m], and ``"axes"``: unit body axes
+        in chain order (upper connector, links 1 … n, lower connector), world
+        frame, each a list of ``[x, y, z]``. Raises `SceneError` for a generic scene.
+        """
+
 @final
 class Simulation:
     """One run of a scene. Advance it, then `finish` it once."""

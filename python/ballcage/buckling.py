@@ -134,9 +134,10 @@ def buckling(
         raise ValueError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
     pitch, n = float(s.value("pipe.pitch")), int(s.value("pipe.joints"))
     mass, gravity = _link_mass(s), float(s.value("world.gravity"))
-    points, tangents = _placed_chain(
-        float(s.value("borehole.curvature_radius")), math.radians(float(s.value("borehole.build_angle_deg"))), pitch, n
-    )
+    placed = s.placed_chain()
+    # The bend plane is x–z (world y is its normal): work in (x, z).
+    points = [(p[0], p[2]) for p in placed["hinges"]]
+    tangents = [(a[0], a[2]) for a in placed["axes"]]
     bends = tuple(math.acos(max(-1.0, min(1.0, _dot(a, b)))) for a, b in zip(tangents, tangents[1:], strict=False))
     hinges = tuple(
         _hinge_drive(k, points, bends, mass, gravity, pitch, friction_moment, bending_stiffness) for k in range(1, n)
@@ -252,35 +253,6 @@ def _link_mass(s: _native.Scene) -> float:
     if s.value("pipe.hinge") == "ideal-cv":
         mass += float(s.value("pipe.ball_keys.cage_mass")) + 6.0 * float(s.value("pipe.ball_keys.ball_mass"))
     return mass
-
-
-def _centreline(radius: float, build: float, arc_length: float) -> tuple[float, float]:
-    """Point (x, z) [m] at `arc_length` along the tube centreline, straight past the arc (docs/model.md §4)."""
-    end = radius * build
-    if arc_length <= end:
-        a = arc_length / radius
-        return radius * (1.0 - math.cos(a)), -radius * math.sin(a)
-    x0, z0 = radius * (1.0 - math.cos(build)), -radius * math.sin(build)
-    return x0 + (arc_length - end) * math.sin(build), z0 - (arc_length - end) * math.cos(build)
-
-
-def _placed_chain(
-    radius: float, build: float, pitch: float, n: int
-) -> tuple[list[tuple[float, float]], list[tuple[float, float]]]:
-    """Hinge points 0 … n on the centreline one pitch apart (chords), and the body axes 0 … n+1 (x, z)."""
-    points, s = [(0.0, 0.0)], 0.0
-    for _ in range(n):
-        lo, hi = s, s + 2.0 * pitch  # the chord to the next hinge is reached within two pitches of arc
-        for _ in range(200):
-            mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if _dist(_centreline(radius, build, mid), points[-1]) < pitch else (lo, mid)
-        s = 0.5 * (lo + hi)
-        points.append(_centreline(radius, build, s))
-    ahead = min(s, radius * build) / radius
-    tangents = [(0.0, -1.0)]
-    tangents += [((b[0] - a[0]) / pitch, (b[1] - a[1]) / pitch) for a, b in zip(points, points[1:], strict=False)]
-    tangents.append((math.sin(ahead), -math.cos(ahead)))
-    return points, tangents
 
 
 def _hinge_drive(

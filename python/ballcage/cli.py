@@ -24,7 +24,6 @@ import json
 import math
 import shlex
 import sys
-import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import NoReturn, TypeAlias
@@ -43,9 +42,6 @@ TABLE_NAMES: tuple[str, ...] = tuple(_native.TABLE_NAMES)
 STABILITY_PARAMETERS: tuple[str, ...] = ("stiffness", "speed", "curvature_radius", "key_mass", "damping")
 #: What `ballcage run` names the embedded scene in messages.
 DEFAULT_SCENE_NAME = "default scene"
-#: The engineering tables `ballcage run` adds to what a drill-pipe scene records when neither the
-#: scene file nor ``--set`` chooses ``record.tables`` (``--tables`` chooses exactly).
-DRILL_PIPE_TABLES: tuple[str, ...] = ("links", "hinges", "keys", "drive", "summary", "pairs")
 
 
 class UsageError(Exception):
@@ -122,8 +118,8 @@ def _add_run_command(commands: _Commands) -> None:
         help="simulate a scene and write Parquet tables",
         description=(
             "Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml. "
-            "The tables are the scene's record.tables; a drill-pipe scene that does not set record.tables "
-            f"(the embedded one, or a file without it) also records {', '.join(DRILL_PIPE_TABLES)}. "
+            "The tables are the scene's record.tables; a drill-pipe scene records by default bodies, "
+            "contacts and the engineering tables links, hinges, keys, drive, summary and pairs. "
             "--tables chooses the tables instead."
         ),
     )
@@ -144,8 +140,7 @@ def _add_run_command(commands: _Commands) -> None:
         metavar="NAME,...",
         help=(
             f"tables to record, e.g. --tables links,drive (known: {', '.join(TABLE_NAMES)}; `ballcage schema` "
-            "describes them); default: the scene's record.tables, for a drill-pipe scene that does not set it "
-            f"also {','.join(DRILL_PIPE_TABLES)}"
+            "describes them); default: the scene's record.tables"
         ),
     )
     _add_set_option(run)
@@ -367,7 +362,7 @@ def _run(args: argparse.Namespace) -> int:
         )
     chosen = _names("--tables", args.tables, TABLE_NAMES, "table")
     scene = _load_cli_scene(args.scene, overrides)
-    tables = _run_tables(scene, chosen, args.scene, overrides)
+    tables = chosen
     if tables is not None:
         try:
             scene = _load_cli_scene(args.scene, [*overrides, "record.tables=" + json.dumps(tables)])
@@ -390,36 +385,6 @@ def _run(args: argparse.Namespace) -> int:
         for name, path in paths.items():
             print(_summary(name, path, result.tables.get(name)))
     return 0
-
-
-def _run_tables(
-    scene: _native.Scene, chosen: list[str] | None, path: str | None, overrides: Sequence[str]
-) -> list[str] | None:
-    """The tables `ballcage run` records when they are not the scene's own choice, else ``None``.
-
-    `chosen` (``--tables``) wins; a drill-pipe scene whose file and `overrides`
-    leave ``record.tables`` out records `DRILL_PIPE_TABLES` besides its own.
-    """
-    if chosen is not None:
-        return chosen
-    if scene.kind != "drill-pipe" or _sets_record_tables(path, overrides):
-        return None
-    return list(dict.fromkeys([*scene.table_names, *DRILL_PIPE_TABLES]))
-
-
-def _sets_record_tables(path: str | None, overrides: Sequence[str]) -> bool:
-    """Whether the scene file at `path` or an override sets ``record.tables`` (or the whole ``record``)."""
-    keys = [o.partition("=")[0].strip() for o in overrides]
-    if any(k == "record" or k.startswith("record.tables") for k in keys):
-        return True
-    if path is None:
-        return False
-    try:
-        document = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):  # the scene loaded: not expected
-        return False
-    record = document.get("record")
-    return isinstance(record, dict) and "tables" in record
 
 
 def _positive(option: str, text: str | None, what: str = "a positive time in seconds") -> float | None:

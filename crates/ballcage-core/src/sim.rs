@@ -287,6 +287,10 @@ impl Simulation {
                 stats.halvings.to_string(),
             ),
             (
+                "ballcage.fallback_steps".to_string(),
+                stats.fallbacks.to_string(),
+            ),
+            (
                 "ballcage.wall_time_s".to_string(),
                 format!("{:.6}", self.wall.as_secs_f64()),
             ),

@@ -294,11 +294,11 @@ fn the_jacobian_is_reused_while_newton_converges_fast() {
 }
 
 #[test]
-fn newton_that_cannot_converge_is_a_divergence_error() {
+fn newton_that_cannot_converge_is_a_divergence_error_without_the_fallback() {
     let mut sim = loaded_key(
         1e-4,
         10.0,
-        "newton = { tolerance = 1e-300, max_iterations = 3 }",
+        "newton = { tolerance = 1e-300, max_iterations = 3, fallback = false }",
     );
     let e = sim.run().unwrap_err();
     let text = e.to_string();
@@ -310,4 +310,28 @@ fn newton_that_cannot_converge_is_a_divergence_error() {
     assert_eq!(e.step, 0);
     // The run stays stopped.
     assert!(sim.step().is_err());
+}
+
+/// With the fallback (the default) a step whose Newton iterations cannot
+/// converge (tolerance 1e-300) is halved four times and each h/16 part step
+/// that still fails is taken by the linearly implicit Euler step, so the run
+/// completes: every fallback is an h/16 part step (15 halvings per 16), and
+/// the key settles where the IMPACT law carries its weight,
+/// δ = (m·g/K)^(1/2.2) = (6000 N / 1e5 N/mm^2.2)^(1/2.2) = 0.2781 mm.
+#[test]
+fn newton_that_cannot_converge_falls_back_to_linearly_implicit_euler_at_h_over_16() {
+    let mut sim = loaded_key(
+        1e-4,
+        10.0,
+        "newton = { tolerance = 1e-300, max_iterations = 3 }",
+    );
+    sim.run().unwrap();
+    let stats = sim.solver_stats();
+    assert_eq!(sim.steps(), 500);
+    assert!(stats.fallbacks > 500, "{stats:?}");
+    assert!(16 * stats.halvings >= 15 * stats.fallbacks, "{stats:?}");
+    let i = common::body(&sim, "key");
+    let depth = 0.0075 - sim.state().pos[i].z;
+    let hand = (6000.0f64 / 1e5).powf(1.0 / 2.2) * 1e-3;
+    assert!((depth - hand).abs() < 1e-3 * hand, "{depth} m vs {hand} m");
 }

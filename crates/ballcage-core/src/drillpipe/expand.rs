@@ -85,6 +85,14 @@ impl DrillPipeSpec {
             self.pipe.joints + 1,
         )
     }
+
+    /// The chain as placed at t = 0: hinge centres 0…n [m] and unit body
+    /// axes in chain order (upper connector, links 1…n, lower connector),
+    /// world frame.
+    pub fn placed_chain(&self) -> (Vec<Vec3>, Vec<Vec3>) {
+        let p = Placement::new(self);
+        (p.hinges, p.axes)
+    }
 }
 
 /// The chain's initial placement: hinge centres, body axes and orientations.

@@ -448,8 +448,19 @@ impl PipeTable {
 }
 
 impl TableChoice for PipeTable {
+    /// Everything an engineer reads: the engine's bodies and contacts and
+    /// the drill pipe's links, hinges, keys, drive, summary and pairs.
     fn defaults() -> Vec<Self> {
-        vec![PipeTable::Bodies, PipeTable::Contacts]
+        vec![
+            PipeTable::Bodies,
+            PipeTable::Contacts,
+            PipeTable::Links,
+            PipeTable::Hinges,
+            PipeTable::Keys,
+            PipeTable::Drive,
+            PipeTable::Summary,
+            PipeTable::Pairs,
+        ]
     }
 
     fn table_name(self) -> &'static str {

@@ -193,6 +193,9 @@ pub struct Stats {
     /// Steps (or part steps) retried as two halves because Newton did not
     /// converge (SDIRK2).
     pub halvings: u64,
+    /// Part steps of h/16 that SDIRK2's Newton could not solve and that
+    /// were taken by the linearly implicit Euler step instead.
+    pub fallbacks: u64,
 }
 
 /// γ of SDIRK2.
@@ -293,9 +296,12 @@ impl Implicit {
     }
 
     /// One SDIRK2 step of `h` seconds. A step whose Newton iterations do not
-    /// converge is retried as two half steps, down to h/16; an error names
-    /// the stage that still did not converge (the state is then left at the
-    /// end of the last part step that did).
+    /// converge is retried as two half steps, down to h/16. A part step of
+    /// h/16 that still does not converge is taken by the linearly implicit
+    /// Euler step (one linear solve, first order, no iteration to fail) when
+    /// `model.newton.fallback` is set, and counted in [`Stats::fallbacks`];
+    /// otherwise the error names the stage that did not converge (the state
+    /// is then left at the end of the last part step that did).
     pub(crate) fn sdirk2_step(
         &mut self,
         model: &Model,
@@ -319,6 +325,13 @@ impl Implicit {
                 self.stats.halvings += 1;
                 self.sdirk2_split(model, dynamics, state, h / 2.0, depth + 1)?;
                 self.sdirk2_split(model, dynamics, state, h / 2.0, depth + 1)
+            }
+            Err(_) if model.newton.fallback => {
+                self.stats.fallbacks += 1;
+                self.step(model, dynamics, state, h);
+                // The factorization is the Euler step's, not SDIRK2's.
+                self.refresh = true;
+                Ok(())
             }
             Err(e) => Err(format!(
                 "{e} (with the step halved {MAX_HALVINGS} times, to {h:.3e} s)"

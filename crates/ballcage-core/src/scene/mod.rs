@@ -132,6 +132,14 @@ pub struct NewtonSpec {
     pub reuse_jacobian: bool,
     /// See `reuse_jacobian`. Default 3.
     pub reuse_iterations: u32,
+    /// When a step's Newton iterations still fail after halving it four
+    /// times, take that h/16 part step with the linearly implicit Euler step
+    /// (first order, one linear solve) and go on, instead of stopping the
+    /// run. The run's metadata counts such steps (`ballcage.fallback_steps`).
+    /// Default true: the friction of the light ball keys leaves SDIRK2's
+    /// Newton without a solution it can reach in a few steps of a paper run
+    /// (docs/accuracy.md).
+    pub fallback: bool,
 }
 
 impl Default for NewtonSpec {
@@ -141,6 +149,7 @@ impl Default for NewtonSpec {
             max_iterations: 20,
             reuse_jacobian: true,
             reuse_iterations: 3,
+            fallback: true,
         }
     }
 }
