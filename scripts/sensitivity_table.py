@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Side-by-side table of `ballcage paper` runs that differ in one parameter.
 
-    python3 scripts/sensitivity_table.py LABEL=DIR [LABEL=DIR ...]
+    python3 scripts/sensitivity_table.py LABEL=DIR [LABEL=DIR ...]   (split at the last "=")
 
 Each DIR is the output folder of a `ballcage paper` run. Prints a markdown
 table: a column per run; rows are the chain's shape statistics computed here
@@ -76,7 +76,7 @@ def comparison_rows(folder: Path) -> dict[str, tuple[float, str]]:
 
 
 def main(argv: list[str]) -> int:
-    runs = [a.split("=", 1) for a in argv]
+    runs = [a.rsplit("=", 1) for a in argv]
     if not runs or any(len(r) != 2 for r in runs):
         print(__doc__, file=sys.stderr)
         return 2

@@ -6,8 +6,9 @@
 //! part is ever found again by its name. Order: the tube, the upper
 //! connector, links 1…n, the lower connector, then per hinge its cage and
 //! six keys (ball-key hinges only). Pairs: each link with the tube, then per
-//! hinge cage–head, cage–seat and per key the four race flanks and two
-//! window faces.
+//! hinge cage–head and cage–seat (ball keys), the neck–mouth articulation
+//! pair (both hinge models, unless `pipe.neck_radius` is 0), and per key the
+//! four race flanks and two window faces.
 
 use super::cv::CvGeometry;
 use super::layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
