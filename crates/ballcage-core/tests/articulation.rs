@@ -169,3 +169,25 @@ fn without_a_neck_the_hinge_folds_far_past_the_limit() {
     let peak = samples.iter().map(|s| s.0).fold(0.0, f64::max);
     assert!(peak > limit_deg() + 5.0, "peak bend {peak}°");
 }
+
+#[test]
+fn a_neck_the_model_cannot_stop_at_the_mouth_is_refused_by_name() {
+    let load = |r: &str| {
+        Document::from_toml_str(
+            "kind = \"drill-pipe\"\n",
+            &[format!("pipe.neck_radius={r}")],
+        )
+    };
+    // r = 23 mm meets the cage rim at 2·(acos(23/31) − asin(20/31)) = 3.85°,
+    // before the mouth at acos(23/32.01) − asin(20/32.01) = 5.40°.
+    let e = load("0.023").unwrap_err();
+    assert_eq!(e.path, "pipe.neck_radius");
+    assert!(
+        e.reason.contains("3.85°") && e.reason.contains("5.40°"),
+        "{e}"
+    );
+    // Wider than the mouth itself, √(32.01² − 20²) = 24.99 mm: no bend at all.
+    let e = load("0.0255").unwrap_err();
+    assert!(e.reason.contains("seat's mouth, radius 0.02499"), "{e}");
+    assert!(load("0.0211").is_ok());
+}
