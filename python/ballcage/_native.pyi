@@ -137,7 +137,9 @@ class Scene:
 
         Keys ``"hinges"``: hinge centres 0 … n [m], and ``"axes"``: unit body axes
         in chain order (upper connector, links 1 … n, lower connector), world
-        frame, each a list of ``[x, y, z]``. Raises `SceneError` for a generic scene.
+        frame, each a list of ``[x, y, z]``; ``"masses"``: those bodies' masses
+        [kg] as built (the ideal-CV links carry their hinges' cage and keys).
+        Raises `SceneError` for a generic scene.
         """
 
 @final

@@ -35,7 +35,6 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ballcage import _native
 from ballcage.scene import SceneSource, default_scene, load_scene
 
 if TYPE_CHECKING:
@@ -133,8 +132,9 @@ def buckling(
     if s.kind != "drill-pipe":
         raise ValueError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
     pitch, n = float(s.value("pipe.pitch")), int(s.value("pipe.joints"))
-    mass, gravity = _link_mass(s), float(s.value("world.gravity"))
     placed = s.placed_chain()
+    # Link 1's mass as built (the ideal-CV links carry their hinges' cage and keys).
+    mass, gravity = float(placed["masses"][1]), float(s.value("world.gravity"))
     # The bend plane is x–z (world y is its normal): work in (x, z).
     points = [(p[0], p[2]) for p in placed["hinges"]]
     tangents = [(a[0], a[2]) for a in placed["axes"]]
@@ -245,14 +245,6 @@ def _check_terms(friction_moment: float, bending_stiffness: float, axial_tension
             raise ValueError(f"{name} = {value} {unit}: must be a finite number ≥ 0 (a resistance, not a drive)")
     if not math.isfinite(axial_tension):
         raise ValueError(f"axial_tension = {axial_tension} N: must be finite (tension positive, compression negative)")
-
-
-def _link_mass(s: _native.Scene) -> float:
-    """Link mass [kg]; the ideal-CV model adds one hinge's cage and keys to each link (docs/model.md §3)."""
-    mass = float(s.value("pipe.link_mass"))
-    if s.value("pipe.hinge") == "ideal-cv":
-        mass += float(s.value("pipe.ball_keys.cage_mass")) + 6.0 * float(s.value("pipe.ball_keys.ball_mass"))
-    return mass
 
 
 def _hinge_drive(

@@ -191,11 +191,17 @@ impl ContactWatch {
         )
     }
 
-    fn see(&mut self, k: usize, pair: &ContactPair, e: &ContactEval, d: &PointDerivatives) {
-        let ratio = e.point.depth / pair.depth_limit;
+    /// Notes a point of pair `k` at penetration `depth` [m] for
+    /// [`ContactWatch::deepest`]; geometry only, no force law.
+    pub fn see_depth(&mut self, k: usize, pair: &ContactPair, depth: f64) {
+        let ratio = depth / pair.depth_limit;
         if ratio > self.deepest.map_or(0.0, |(_, _, r)| r) {
-            self.deepest = Some((k, e.point.depth, ratio));
+            self.deepest = Some((k, depth, ratio));
         }
+    }
+
+    fn see(&mut self, k: usize, pair: &ContactPair, e: &ContactEval, d: &PointDerivatives) {
+        self.see_depth(k, pair, e.point.depth);
         if e.normal_force <= 0.0 || !pair.reduced_mass.is_finite() {
             return;
         }

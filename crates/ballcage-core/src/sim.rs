@@ -544,23 +544,20 @@ fn what_to_check(failure: Failure) -> &'static str {
 }
 
 /// The deepest penetration of any pair at `state` relative to its pair's
-/// limit: (pair, depth [m], depth / limit), `None` without contact.
+/// limit, (pair, depth [m], depth / limit), from the contact geometry alone
+/// (no force evaluation); `None` without contact.
 fn deepest_penetration(
     model: &Model,
     state: &State,
     dynamics: &mut Dynamics,
 ) -> Option<(usize, f64, f64)> {
-    let mut points = Vec::new();
-    let mut deepest: Option<(usize, f64, f64)> = None;
+    let (mut points, mut watch) = (Vec::new(), ContactWatch::default());
     for (k, pair) in model.pairs.iter().enumerate() {
         points.clear();
         dynamics.contact_points(model, state, k, &mut points);
         for e in &points {
-            let ratio = e.point.depth / pair.depth_limit;
-            if ratio > deepest.map_or(0.0, |d| d.2) {
-                deepest = Some((k, e.point.depth, ratio));
-            }
+            watch.see_depth(k, pair, e.point.depth);
         }
     }
-    deepest
+    watch.deepest
 }

@@ -179,17 +179,21 @@ impl Scene {
         Ok(spec.articulation_limit().map(f64::to_degrees))
     }
 
-    /// The chain as placed at t = 0: `hinges` (centres 0…n [m]) and `axes`
-    /// (unit body axes: upper connector, links 1…n, lower connector), world frame.
+    /// The chain as placed at t = 0: `hinges` (centres 0…n [m]), `axes`
+    /// (unit body axes) and `masses` [kg] of the bodies as built (upper
+    /// connector, links 1…n, lower connector), world frame.
     fn placed_chain<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let (spec, _) = self.drill_pipe(py, "placed_chain")?;
+        let (spec, layout) = self.drill_pipe(py, "placed_chain")?;
         let (hinges, axes) = spec.placed_chain();
         let rows = |v: Vec<ballcage_core::math::Vec3>| -> Vec<Vec<f64>> {
             v.iter().map(|p| vec![p.x, p.y, p.z]).collect()
         };
+        let bodies = &self.inner.scene().bodies;
+        let masses: Vec<Option<f64>> = layout.chain.iter().map(|&i| bodies[i].mass).collect();
         let out = PyDict::new(py);
         out.set_item("hinges", rows(hinges))?;
         out.set_item("axes", rows(axes))?;
+        out.set_item("masses", masses)?;
         Ok(out)
     }
 

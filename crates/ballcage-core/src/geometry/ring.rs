@@ -10,7 +10,7 @@
 //!
 //! For an axis through the ring's axis at distance h from the ring's plane,
 //! tilted by t from ê, the nearest ring point lies in the plane of the tilt
-//! and √g = ρ·cos t − h·sin t (physics.md §3, docs/model.md §3): the
+//! and √g = ρ·cos t − h·sin t (docs/model.md §3): the
 //! closed form the tests check.
 
 use super::ContactPoint;
