@@ -414,7 +414,7 @@ def test_cli_stability_writes_the_files_and_exits_0(tmp_path, capsys):
     [
         (["accuracy", "--integrators", "rk5"], "--integrators rk5"),
         (["accuracy", "--steps", "-1e-5"], "--steps -1e-5"),
-        (["accuracy", "--steps", "rk4=0"], "--steps 0"),
+        (["accuracy", "--steps", "sdirk2=0"], "--steps 0"),
         (["accuracy", "--reference-dt", "-2e-6"], "--reference-dt -2e-6"),
         (["accuracy", "--reference-integrator", "euler"], "--reference-integrator euler"),
         (["accuracy", "--duration", "0"], "--duration 0"),

@@ -189,7 +189,9 @@ def _add_accuracy_command(commands: _Commands) -> None:
         help="scene file (TOML); without it, the embedded paper scene (use --duration to keep it affordable)",
     )
     _add_out_option(accuracy)
-    _add_integrators_option(accuracy)
+    _add_integrators_option(
+        accuracy, "all; on drill pipes the implicit ones only, the explicit ones needing 0.1-2 us steps there"
+    )
     accuracy.add_argument(
         "--steps",
         metavar="[INTEGRATOR=]DT,DT,...",
@@ -197,7 +199,7 @@ def _add_accuracy_command(commands: _Commands) -> None:
         default=[],
         help=(
             "ladder of steps [s] for every integrator, or for one with INTEGRATOR=...; repeatable "
-            "(default: drill pipes 0.1-1 us explicit, 5-200 us implicit; generic scenes 0.25-2x the scene's dt "
+            "(default: drill pipes 20-200 us implicit, 0.1-2 us explicit when named; generic scenes 0.25-2x the scene's dt "
             "explicit, 1-8x implicit)"
         ),
     )
@@ -311,11 +313,11 @@ def _add_set_option(parser: argparse.ArgumentParser, example: str | None = None)
     )
 
 
-def _add_integrators_option(parser: argparse.ArgumentParser) -> None:
+def _add_integrators_option(parser: argparse.ArgumentParser, default: str | None = None) -> None:
     parser.add_argument(
         "--integrators",
         metavar="NAME,...",
-        help=f"integrators to study (default all: {','.join(_native.INTEGRATORS)})",
+        help=f"integrators to study (default {default or 'all: ' + ','.join(_native.INTEGRATORS)})",
     )
 
 
@@ -384,7 +386,24 @@ def _run(args: argparse.Namespace) -> int:
     if not args.quiet:
         for name, path in paths.items():
             print(_summary(name, path, result.tables.get(name)))
+        print(_cost(result.metadata))
     return 0
+
+
+def _cost(meta: dict[str, str]) -> str:
+    """One line on what the run cost: wall time, real-time factor, solver work."""
+    steps = int(meta["ballcage.steps"])
+    simulated = steps * float(meta["ballcage.dt_s"])
+    line = (
+        f"ballcage: {simulated:.4g} s simulated in {float(meta['ballcage.wall_time_s']):.3g} s of wall time "
+        f"(real-time factor {float(meta['ballcage.real_time_factor']):.3g}); "
+        f"{meta['ballcage.integrator']} at {float(meta['ballcage.dt_s']):g} s, {steps} steps"
+    )
+    if meta["ballcage.integrator"] == "sdirk2" and steps > 0:
+        per_stage = int(meta["ballcage.newton_iterations"]) / (2 * steps)
+        per_step = int(meta["ballcage.factorizations"]) / steps
+        line += f", {per_stage:.2f} Newton iterations per stage, {per_step:.2f} factorizations per step"
+    return line
 
 
 def _positive(option: str, text: str | None, what: str = "a positive time in seconds") -> float | None:
@@ -455,16 +474,17 @@ def _steps_option(texts: Sequence[str], integrators: Sequence[str]) -> list[floa
 
 def _accuracy(args: argparse.Namespace) -> int:
     from ballcage.studies import accuracy, write_accuracy  # deferred: numpy, matplotlib
+    from ballcage.studies.accuracy_run import default_integrators
 
     known = list(_native.INTEGRATORS)
-    integrators = _names("--integrators", args.integrators, known, "integrator") or known
     reference = _names("--reference-integrator", args.reference_integrator, known, "integrator")
-    steps = _steps_option(args.steps, integrators)
     reference_dt = _positive("--reference-dt", args.reference_dt, "a positive step in seconds")
     duration = _positive("--duration", args.duration)
     overrides = [_checked_override(o) for o in args.overrides]
     out = _checked_out(args.out)
     scene = _load_cli_scene(args.scene, overrides)
+    integrators = _names("--integrators", args.integrators, known, "integrator") or default_integrators(scene)
+    steps = _steps_option(args.steps, integrators)
     table = accuracy(
         scene,
         integrators=integrators,

@@ -30,30 +30,37 @@ fn scene(n: usize) -> Scene {
     Scene::from_toml_str(&toml, &[]).expect("valid bench scene")
 }
 
-/// The paper's drill pipe (12 ball-key joints, 106 bodies, 506 pairs) for
-/// the first 5 ms, with each implicit integrator at its recommended step
-/// (docs/accuracy.md).
+/// The paper's drill pipe (12 joints; ball keys: 106 bodies, 519 pairs;
+/// ideal CV: 15 bodies) for 20 ms from rest, with each implicit integrator
+/// at its step and each linear solver: block elimination along the bodies'
+/// graph (the default) against faer's general sparse LU.
 fn paper(c: &mut Criterion) {
-    let mut g = c.benchmark_group("paper scene, first 5 ms");
+    let mut g = c.benchmark_group("paper scene, first 20 ms");
     g.sample_size(10);
-    for (integrator, dt) in [("linearly-implicit-euler", 1e-5), ("sdirk2", 1e-4)] {
-        let s = Document::from_toml_str(
-            "kind = \"drill-pipe\"\n",
-            &[
-                format!("simulation.integrator=\"{integrator}\""),
-                format!("simulation.dt={dt}"),
-                "simulation.duration=0.005".to_string(),
-                "record.tables=[]".to_string(),
-            ],
-        )
-        .expect("valid paper scene");
-        g.bench_function(format!("{integrator} at {dt} s"), |b| {
-            b.iter(|| {
-                let mut sim = s.simulation();
-                sim.run().expect("stable");
-                sim.steps()
-            })
-        });
+    for hinge in ["ball-keys", "ideal-cv"] {
+        for (integrator, dt) in [("linearly-implicit-euler", 1e-4), ("sdirk2", 1e-4)] {
+            for solver in ["block-elimination", "sparse-lu"] {
+                let s = Document::from_toml_str(
+                    "kind = \"drill-pipe\"\n",
+                    &[
+                        format!("pipe.hinge=\"{hinge}\""),
+                        format!("simulation.integrator=\"{integrator}\""),
+                        format!("simulation.dt={dt}"),
+                        format!("simulation.newton.linear_solver=\"{solver}\""),
+                        "simulation.duration=0.02".to_string(),
+                        "record.tables=[]".to_string(),
+                    ],
+                )
+                .expect("valid paper scene");
+                g.bench_function(format!("{hinge}, {integrator} at {dt} s, {solver}"), |b| {
+                    b.iter(|| {
+                        let mut sim = s.simulation();
+                        sim.run().expect("stable");
+                        sim.steps()
+                    })
+                });
+            }
+        }
     }
     g.finish();
 }

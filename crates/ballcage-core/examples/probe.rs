@@ -14,7 +14,7 @@ fn main() {
     let overrides: Vec<String> = vec![
         format!("simulation.dt={dt}"),
         format!("simulation.integrator=\"{integ}\""),
-        format!("simulation.duration={dur}"),
+        "simulation.duration=100".to_string(),
     ];
     let mut all = overrides.clone();
     all.extend(args.iter().skip(4).cloned());
@@ -27,12 +27,27 @@ fn main() {
         scene.contacts.len()
     );
     let mut sim = doc.simulation();
+    // PROBE_WARM=T: run to T first; the rest runs inside `window` (for
+    // callgrind --toggle-collect=*window*).
+    if let Ok(warm) = std::env::var("PROBE_WARM") {
+        let warm: f64 = warm.parse().expect("PROBE_WARM in seconds");
+        sim.advance_to(warm).expect("warm-up");
+        println!("warm to {warm} s: steps {}", sim.steps());
+    }
+    window(&mut sim, dur.parse().unwrap());
+}
+
+#[inline(never)]
+fn window(sim: &mut ballcage_core::Simulation, dur: f64) {
+    let t_start = sim.time();
     let t0 = Instant::now();
-    let dur: f64 = dur.parse().unwrap();
+    let st0 = sim.solver_stats();
+    let ev0 = sim.force_evaluations();
+    let steps0 = sim.steps();
     let mut k = 0;
-    while !sim.is_done() {
+    while k < 10 {
         k += 1;
-        let r = sim.advance_to(dur * k as f64 / 10.0);
+        let r = sim.advance_to(t_start + dur * k as f64 / 10.0);
         let e = sim.energy();
         println!(
             "t={:.5} steps={} wall={:.2}s KE={:.4e} Ec={:.4e} {:?}",
@@ -43,17 +58,20 @@ fn main() {
             e.potential_contact,
             r.err()
         );
-        if sim.time() < dur * k as f64 / 10.0 - 1e-9 {
+        if sim.time() < t_start + dur * k as f64 / 10.0 - 1e-9 {
             break;
         }
     }
     let st = sim.solver_stats();
     println!(
-        "force evaluations {} factorizations {} solves {} newton iterations {} halvings {}",
-        sim.force_evaluations(),
-        st.factorizations,
-        st.solves,
-        st.newton_iterations,
-        st.halvings
+        "window: steps {} force evaluations {} factorizations {} solves {} newton iterations {} halvings {} fallbacks {} wall {:.3} s",
+        sim.steps() - steps0,
+        sim.force_evaluations() - ev0,
+        st.factorizations - st0.factorizations,
+        st.solves - st0.solves,
+        st.newton_iterations - st0.newton_iterations,
+        st.halvings - st0.halvings,
+        st.fallbacks - st0.fallbacks,
+        t0.elapsed().as_secs_f64()
     );
 }

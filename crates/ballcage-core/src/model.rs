@@ -263,7 +263,7 @@ impl Model {
 /// Mutable state: cheap to clone, so integrator stages copy it.
 ///
 /// All arrays are indexed by body id; fixed bodies keep their initial values.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub struct State {
     /// Time [s].
     pub t: f64,
@@ -275,6 +275,28 @@ pub struct State {
     pub vel: Vec<Vec3>,
     /// Angular velocities [rad/s], **body frame**.
     pub omega: Vec<Vec3>,
+}
+
+impl Clone for State {
+    fn clone(&self) -> Self {
+        Self {
+            t: self.t,
+            pos: self.pos.clone(),
+            rot: self.rot.clone(),
+            vel: self.vel.clone(),
+            omega: self.omega.clone(),
+        }
+    }
+
+    /// Field by field, reusing the arrays' memory: the integrators copy
+    /// states every step and must not allocate.
+    fn clone_from(&mut self, source: &Self) {
+        self.t = source.t;
+        self.pos.clone_from(&source.pos);
+        self.rot.clone_from(&source.rot);
+        self.vel.clone_from(&source.vel);
+        self.omega.clone_from(&source.omega);
+    }
 }
 
 impl State {

@@ -294,6 +294,10 @@ impl Simulation {
                 "ballcage.wall_time_s".to_string(),
                 format!("{:.6}", self.wall.as_secs_f64()),
             ),
+            (
+                "ballcage.real_time_factor".to_string(),
+                format!("{:.6}", self.state.t / self.wall.as_secs_f64().max(1e-9)),
+            ),
             ("ballcage.complete".to_string(), complete.to_string()),
         ];
         if let Some(e) = &self.failed {

@@ -21,6 +21,7 @@ from ballcage.studies.common import (
     available_integrators,
     check_duration,
     check_integrators,
+    family,
     is_drill_pipe,
     meta_int,
     record,
@@ -31,7 +32,7 @@ from ballcage.studies.ladders import ladders, reference_step, snap_grid
 from ballcage.studies.scalars import FLOORS, MAX_QUANTITY, Quantity, quantities, relative_error
 from ballcage.studies.schemas import ACCURACY_SCHEMA
 
-__all__ = ["DRILL_PIPE_TABLES", "GENERIC_TABLES", "accuracy"]
+__all__ = ["DRILL_PIPE_TABLES", "GENERIC_TABLES", "accuracy", "default_integrators"]
 
 #: Tables a study records, by scene kind.
 DRILL_PIPE_TABLES: tuple[str, ...] = ("links", "keys", "energy")
@@ -54,7 +55,10 @@ def accuracy(
 
     `scene`: anything `ballcage.load_scene` takes; ``None`` is the embedded
     paper scene (`overrides` then address its drill-pipe TOML).
-    `integrators`: names (default every one, `available_integrators()`).
+    `integrators`: names (default every one, `available_integrators()`; on
+    drill-pipe scenes the implicit ones only: the ball keys need explicit
+    steps of 0.1–1 µs, hours for a paper run, so explicit ladders are asked
+    for by name).
     `steps` [s]: one ladder for all, or a mapping integrator → ladder
     (default `default_steps`). `reference_integrator`: default ``"sdirk2"``.
     `reference_dt` [s]: default the reference integrator's smallest default
@@ -67,19 +71,26 @@ def accuracy(
     invalid scene or override (before anything runs), `ValueError` for bad
     arguments and `StudyError` when the reference itself diverges.
     """
-    names = check_integrators(integrators if integrators is not None else available_integrators(), "integrators")
     ref_integrator = reference_integrator or REFERENCE_INTEGRATOR
     check_integrators([ref_integrator], "reference_integrator")
     floor_values = _floor_values(floors)
     check_duration(duration)
     base = resolve(scene, overrides)
     drill_pipe = is_drill_pipe(base)
+    names = check_integrators(integrators if integrators is not None else default_integrators(base), "integrators")
     base = load_scene(base, [record(DRILL_PIPE_TABLES if drill_pipe else GENERIC_TABLES)])
     plan = _plan(base, names, ref_integrator, steps, reference_dt, duration)
     say = Say(progress)
     say(plan.headline())
+    if progress:
+        say(_estimate(plan))
     outcomes = _run_all(plan, floor_values, say)
     return _table(plan, outcomes, floor_values, base, drill_pipe)
+
+
+def default_integrators(scene: _native.Scene) -> list[str]:
+    """The integrators a study compares when none are named: all, or on a drill pipe the implicit ones only."""
+    return [n for n in available_integrators() if not is_drill_pipe(scene) or family(n) == "implicit"]
 
 
 def _floor_values(floors: Mapping[str, float] | None) -> dict[str, float]:
@@ -143,6 +154,46 @@ def _plan(
 
 # --------------------------------------------------------------------------- runs
 
+#: Share of each run's duration simulated as a pilot for the study's time estimate.
+PILOT_SHARE = 0.01
+
+
+def _estimate(plan: _Plan) -> str:
+    """The study's expected wall time, from a pilot of each distinct run over `PILOT_SHARE` of the duration."""
+    distinct: dict[tuple[str, float], _native.Scene] = {}
+    for (integrator, dt, _), scene in zip(plan.runs, plan.scenes, strict=True):
+        distinct.setdefault((integrator, dt), scene)
+    total = 0.0
+    for (_, dt), scene in distinct.items():
+        sim = _native.Simulation(scene)
+        start = time.perf_counter()
+        try:
+            sim.advance(max(PILOT_SHARE * plan.duration, 10 * dt))
+        except _native.SimulationError:
+            pass  # the run itself will report it
+        elapsed = time.perf_counter() - start
+        total += elapsed * plan.duration / max(sim.time, dt)
+    return (
+        f"accuracy: at least {_minutes(total)} for the {len(plan.runs)} runs, from pilots over the first "
+        f"{PILOT_SHARE:.0%} of each (later, loaded phases cost more per step; each finished run updates the estimate)"
+    )
+
+
+def _time_left(plan: _Plan, outcomes: Sequence[_Outcome]) -> float:
+    """Wall time [s] the runs after `outcomes` should take, at the cost per simulated second of the
+    finished run nearest in step with the same integrator (else of the reference)."""
+    left = 0.0
+    for integrator, dt, _ in plan.runs[len(outcomes) :]:
+        same = [o for o in outcomes if o.integrator == integrator and not o.diverged] or [outcomes[0]]
+        nearest = min(same, key=lambda o: abs(math.log(o.dt / dt)))
+        left += nearest.wall_s * nearest.dt / dt
+    return left
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
+
+
 
 @dataclass
 class _Outcome:
@@ -172,7 +223,10 @@ def _run_all(plan: _Plan, floors: Mapping[str, float], say: Say) -> list[_Outcom
                 "choose a smaller reference step or another reference integrator"
             )
         outcomes.append(outcome)
-        say(_progress_line(n, len(plan.runs), outcome, outcomes[0], floors))
+        line = _progress_line(n, len(plan.runs), outcome, outcomes[0], floors)
+        if n < len(plan.runs):
+            line += f"; about {_minutes(_time_left(plan, outcomes))} left"
+        say(line)
     return outcomes
 
 

@@ -80,30 +80,40 @@ impl LinkInTube<'_> {
         })
     }
 
-    /// Signed depth at `s` [m], −∞ where there is no station.
-    fn depth(&self, s: f64) -> f64 {
-        self.station(s).map_or(f64::NEG_INFINITY, |st| st.depth)
-    }
-
-    /// The axial position of the largest depth in `[a, b]`, by golden-section
-    /// search to 1e-12 of the positions.
-    fn deepest(&self, a: f64, b: f64) -> f64 {
-        const G: f64 = 0.618_033_988_749_894_8;
-        let (mut a, mut b) = (a, b);
-        let (mut c, mut d) = (b - G * (b - a), a + G * (b - a));
-        let (mut fc, mut fd) = (self.depth(c), self.depth(d));
-        while b - a > 1e-12 * (1.0 + b.abs().max(a.abs())) {
-            if fc > fd {
-                (b, d, fd) = (d, c, fc);
-                c = b - G * (b - a);
-                fc = self.depth(c);
+    /// The axial position in `[a, b]` where the offset from the centreline
+    /// stops growing (u·â = 0, the depth's maximum), given u·â = `ga` > 0 at
+    /// `a` and `gb` ≤ 0 at `b`: the Illinois variant of regula falsi, which
+    /// converges superlinearly on this smooth root, to 1e-12 of the
+    /// positions. `None` if a station on the way does not exist.
+    fn deepest(&self, (mut a, mut ga): (f64, f64), (mut b, mut gb): (f64, f64)) -> Option<f64> {
+        let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
+        // Which end moved last: +1 for a, −1 for b.
+        let mut side = 0;
+        for _ in 0..100 {
+            if b - a <= tolerance {
+                break;
+            }
+            let x = (a * gb - b * ga) / (gb - ga);
+            let x = if x > a && x < b { x } else { 0.5 * (a + b) };
+            let gx = self.station(x)?.growth;
+            if gx > 0.0 {
+                (a, ga) = (x, gx);
+                if side == 1 {
+                    gb *= 0.5;
+                }
+                side = 1;
             } else {
-                (a, c, fc) = (c, d, fd);
-                d = a + G * (b - a);
-                fd = self.depth(d);
+                (b, gb) = (x, gx);
+                if side == -1 {
+                    ga *= 0.5;
+                }
+                side = -1;
+            }
+            if gx == 0.0 {
+                return Some(x);
             }
         }
-        0.5 * (a + b)
+        Some(if ga.abs() < gb.abs() { a } else { b })
     }
 }
 
@@ -225,7 +235,7 @@ fn interior_maximum(
     if !(a.growth > 0.0 && b.growth <= 0.0) {
         return None;
     }
-    let x = link.deepest(sa, sb);
+    let x = link.deepest((sa, a.growth), (sb, b.growth))?;
     link.station(x)
         .filter(|st| st.depth > 0.0)
         .map(|st| (x, st))

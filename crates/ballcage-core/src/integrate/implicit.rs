@@ -56,24 +56,20 @@
 //! # Linear algebra
 //! The sparsity pattern of Bᵀ(M − h·D)B is fixed by the model: a diagonal
 //! block per integrated body and a pair of off-diagonal blocks per declared
-//! contact pair or joint between two integrated bodies. It is built once, at
-//! the first step, with its symbolic LU factorization (`faer`, COLAMD
-//! ordering); each step only refills the values and factors numerically
-//! (partial pivoting: the matrix is not symmetric once friction acts).
-
-use std::collections::{BTreeMap, BTreeSet};
-
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::SupernodalThreshold;
-use faer::sparse::linalg::lu::{
-    LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
-};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par};
+//! contact pair or joint between two integrated bodies. It is analysed
+//! once, at the first step; each step only refills the values and factors
+//! numerically (the matrix is not symmetric once friction acts). The solver
+//! is `simulation.newton.linear_solver`: block elimination along the
+//! bodies' graph ([`super::blocklu`], the default) or a general sparse LU
+//! with pivoting ([`super::sparselu`]).
 
 use crate::dynamics::{Dynamics, Mat6, Mode, VelocityJacobian};
 use crate::math::{Mat3, Vec3, exp_map};
 use crate::model::{Model, Motion, State};
+use crate::scene::LinearSolver;
+
+use super::blocklu::BlockLu;
+use super::sparselu::SparseLu;
 
 /// How a body's unknowns map to its world twist [v; ω].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -93,49 +89,57 @@ impl Basis {
     }
 }
 
-/// Where a block of the reduced matrix sits in the CSC value array: entry
-/// (r, c) of the block is `values[col_ptr[col0 + c] + row_off + r]`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Block {
-    col0: usize,
-    row_off: usize,
+/// The linear solver of the Newton matrix, one interface over both kinds.
+#[derive(Debug, Clone)]
+// One per simulation, inside the boxed workspace: the size does not matter.
+#[allow(clippy::large_enum_variant)]
+enum Linear {
+    Block(BlockLu),
+    Sparse(SparseLu),
 }
 
-/// Scratch memory of the sparse factorization and solve.
-struct Scratch {
-    req: StackReq,
-    buf: MemBuffer,
-}
-
-impl Scratch {
-    fn new(req: StackReq) -> Self {
-        Self {
-            req,
-            buf: MemBuffer::new(req),
+impl Linear {
+    fn new(kind: LinearSolver, offsets: Vec<(usize, usize)>, edges: &[(usize, usize)]) -> Self {
+        match kind {
+            LinearSolver::BlockElimination => Self::Block(BlockLu::new(offsets, edges)),
+            LinearSolver::SparseLu => Self::Sparse(SparseLu::new(&offsets, edges)),
         }
     }
-}
 
-impl Clone for Scratch {
-    fn clone(&self) -> Self {
-        Self::new(self.req)
+    fn block(&self, i: usize, j: usize) -> Option<usize> {
+        match self {
+            Self::Block(lu) => lu.block(i, j),
+            Self::Sparse(lu) => lu.block(i, j),
+        }
     }
-}
 
-impl std::fmt::Debug for Scratch {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Scratch").field("req", &self.req).finish()
+    fn clear(&mut self) {
+        match self {
+            Self::Block(lu) => lu.clear(),
+            Self::Sparse(lu) => lu.clear(),
+        }
     }
-}
 
-/// The symbolic factorization and the buffers of the numeric one.
-#[derive(Debug, Clone)]
-struct Factorization {
-    /// The pattern of Bᵀ(M − h·D)B, checked once.
-    pattern: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicLu<usize>,
-    numeric: NumericLu<usize, f64>,
-    scratch: Scratch,
+    fn add(&mut self, b: usize, m: &Mat6, scale: f64) {
+        match self {
+            Self::Block(lu) => lu.add(b, m, scale),
+            Self::Sparse(lu) => lu.add(b, m, scale),
+        }
+    }
+
+    fn factor(&mut self) -> bool {
+        match self {
+            Self::Block(lu) => lu.factor(),
+            Self::Sparse(lu) => lu.factor(),
+        }
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) {
+        match self {
+            Self::Block(lu) => lu.solve(rhs),
+            Self::Sparse(lu) => lu.solve(rhs),
+        }
+    }
 }
 
 /// Workspace of the implicit steps: the fixed sparsity pattern, its symbolic
@@ -146,20 +150,16 @@ pub(crate) struct Implicit {
     dofs: Vec<Option<(usize, Basis)>>,
     /// Number of unknowns.
     n: usize,
-    /// Column starts of the CSC matrix (also in the pattern).
-    col_ptr: Vec<usize>,
-    /// CSC values.
-    values: Vec<f64>,
     /// Diagonal block of every integrated body.
-    diag: Vec<(usize, Block)>,
+    diag: Vec<(usize, usize)>,
     /// Per coupling of [`VelocityJacobian`]: the blocks (aa, ab, ba, bb),
     /// `None` where a body is not integrated.
-    couplings: Vec<[Option<Block>; 4]>,
+    couplings: Vec<[Option<usize>; 4]>,
     jac: VelocityJacobian,
     /// Right-hand side, then the solution Δq̇.
     rhs: Vec<f64>,
     /// `None` when there are no unknowns.
-    lu: Option<Factorization>,
+    linear: Option<Linear>,
     /// Whether `lu` holds a numeric factorization.
     factored: bool,
     /// SDIRK2: whether the next step starts with a fresh Jacobian.
@@ -217,32 +217,56 @@ impl Implicit {
         let (dofs, n) = unknowns(model);
         let mass_scale = mass_scales(model, &dofs, n);
         let jac = VelocityJacobian::new(model);
-        let (col_ptr, row_idx, blocks) = block_pattern(model, &dofs, &jac);
+        // The nodes are the integrated bodies, in the order of their unknowns.
+        let mut node = vec![None; model.bodies.len()];
+        for (k, &i) in model.integrated.iter().enumerate() {
+            node[i] = Some(k);
+        }
+        let offsets = model
+            .integrated
+            .iter()
+            .map(|&i| {
+                dofs[i]
+                    .map(|(off, basis)| (off, basis.dim()))
+                    .expect("integrated")
+            })
+            .collect();
+        let edges: Vec<(usize, usize)> = jac
+            .couplings
+            .iter()
+            .filter_map(|c| Some((node[c.a]?, node[c.b]?)))
+            .filter(|(a, b)| a != b)
+            .collect();
+        let linear = (n > 0).then(|| Linear::new(model.newton.linear_solver, offsets, &edges));
+        let block = |i: usize, j: usize| {
+            let lu = linear.as_ref()?;
+            lu.block(node[i]?, node[j]?)
+        };
         let diag = model
             .integrated
             .iter()
-            .map(|&i| (i, blocks[&(i, i)]))
+            .map(|&i| (i, block(i, i).expect("diagonal block")))
             .collect();
         let couplings = jac
             .couplings
             .iter()
             .map(|c| {
-                let get = |i: usize, j: usize| blocks.get(&(i, j)).copied();
-                [get(c.a, c.a), get(c.a, c.b), get(c.b, c.a), get(c.b, c.b)]
+                [
+                    block(c.a, c.a),
+                    block(c.a, c.b),
+                    block(c.b, c.a),
+                    block(c.b, c.b),
+                ]
             })
             .collect();
-        let values = vec![0.0; row_idx.len()];
-        let lu = (n > 0).then(|| Factorization::new(n, col_ptr.clone(), row_idx));
         Self {
             dofs,
             n,
-            col_ptr,
-            values,
             diag,
             couplings,
             jac,
             rhs: vec![0.0; n],
-            lu,
+            linear,
             factored: false,
             refresh: true,
             factored_gh: 0.0,
@@ -634,32 +658,25 @@ impl Implicit {
         }
     }
 
-    /// Fills Bᵀ(M − hh·J)B into `values`, J the blocks last evaluated into
-    /// `jac` (D, or D + s·K) and M the mass at `state`.
+    /// Fills Bᵀ(M − hh·J)B into the linear solver, J the blocks last
+    /// evaluated into `jac` (D, or D + s·K) and M the mass at `state`.
     fn assemble_matrix(&mut self, model: &Model, state: &State, hh: f64) {
-        self.values.fill(0.0);
+        let Some(linear) = &mut self.linear else {
+            return;
+        };
+        linear.clear();
         for &(i, blk) in &self.diag {
             let body = &model.bodies[i];
+            let mut mass = Mat6::zeros();
             match (self.dofs[i].expect("integrated").1, body.motion) {
-                (Basis::Axis(_), Motion::Spin { inertia, .. }) => {
-                    self.values[self.col_ptr[blk.col0] + blk.row_off] += inertia;
-                }
+                (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass[(0, 0)] = inertia,
                 _ => {
-                    let mut mass = Mat6::zeros();
                     mass.fixed_view_mut::<3, 3>(0, 0).fill_diagonal(body.mass);
                     mass.fixed_view_mut::<3, 3>(3, 3)
                         .copy_from(&world_inertia(model, state, i));
-                    add_block(
-                        &mut self.values,
-                        &self.col_ptr,
-                        blk,
-                        Basis::Full,
-                        Basis::Full,
-                        &mass,
-                        1.0,
-                    );
                 }
             }
+            linear.add(blk, &mass, 1.0);
         }
         for (c, blocks) in self.jac.couplings.iter().zip(&self.couplings) {
             if !c.active {
@@ -671,7 +688,7 @@ impl Implicit {
                 if let Some(blk) = blk {
                     let bi = self.dofs[i].expect("integrated").1;
                     let bj = self.dofs[j].expect("integrated").1;
-                    add_block(&mut self.values, &self.col_ptr, *blk, bi, bj, m, -hh);
+                    linear.add(*blk, &project(bi, bj, m), -hh);
                 }
             }
         }
@@ -679,42 +696,24 @@ impl Implicit {
 
     /// Factors the assembled matrix; false if the factorization failed.
     fn factor(&mut self) -> bool {
-        let Some(lu) = &mut self.lu else {
+        let Some(linear) = &mut self.linear else {
             return true;
         };
-        let Factorization {
-            pattern,
-            symbolic,
-            numeric,
-            scratch,
-        } = lu;
-        let a = SparseColMatRef::new(pattern.as_ref(), &self.values);
-        let stack = MemStack::new(&mut scratch.buf);
         self.stats.factorizations += 1;
-        self.factored = symbolic
-            .factorize_numeric_lu(numeric, a, Par::Seq, stack, Default::default())
-            .is_ok();
+        self.factored = linear.factor();
         self.factored
     }
 
     /// Overwrites `rhs` with the solution of the factorized system; false
     /// if it is not finite.
     fn solve(&mut self) -> bool {
-        let Some(lu) = &mut self.lu else {
+        let Some(linear) = &mut self.linear else {
             return true;
         };
         if !self.factored {
             return false;
         }
-        // `numeric` is the output of `symbolic.factorize_numeric_lu` on this pattern.
-        let factors = LuRef::new_unchecked(&lu.symbolic, &lu.numeric);
-        let rhs = MatMut::from_column_major_slice_mut(&mut self.rhs, self.n, 1);
-        factors.solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            Par::Seq,
-            MemStack::new(&mut lu.scratch.buf),
-        );
+        linear.solve(&mut self.rhs);
         self.stats.solves += 1;
         self.rhs.iter().all(|x| x.is_finite())
     }
@@ -767,119 +766,30 @@ fn mass_scales(model: &Model, dofs: &[Option<(usize, Basis)>], n: usize) -> Vec<
     mass_scale
 }
 
-/// The CSC pattern of Bᵀ(M − h·D)B (column starts and row indices): a
-/// diagonal block per integrated body and a pair of off-diagonal blocks
-/// per coupling of `jac` between two integrated bodies, with where each
-/// block (row body, column body) sits.
-#[allow(clippy::type_complexity)]
-fn block_pattern(
-    model: &Model,
-    dofs: &[Option<(usize, Basis)>],
-    jac: &VelocityJacobian,
-) -> (Vec<usize>, Vec<usize>, BTreeMap<(usize, usize), Block>) {
-    // Row bodies of each column body.
-    let mut rows: BTreeMap<usize, BTreeSet<(usize, usize)>> = BTreeMap::new();
-    for &i in &model.integrated {
-        let (off, _) = dofs[i].expect("integrated");
-        rows.entry(off).or_default().insert((off, i));
-    }
-    for c in &jac.couplings {
-        if let (Some((oa, _)), Some((ob, _))) = (dofs[c.a], dofs[c.b]) {
-            rows.entry(oa).or_default().insert((ob, c.b));
-            rows.entry(ob).or_default().insert((oa, c.a));
-        }
-    }
-    let mut col_ptr = vec![0usize];
-    let mut row_idx = vec![];
-    let mut blocks: BTreeMap<(usize, usize), Block> = BTreeMap::new();
-    for (&col0, row_bodies) in &rows {
-        let j = row_bodies
-            .iter()
-            .find(|&&(o, _)| o == col0)
-            .map(|&(_, j)| j)
-            .expect("diagonal");
-        let width = dofs[j].expect("integrated").1.dim();
-        let mut row_off = 0;
-        let mut pattern = vec![];
-        for &(off, i) in row_bodies {
-            let dim = dofs[i].expect("integrated").1.dim();
-            blocks.insert((i, j), Block { col0, row_off });
-            pattern.extend(off..off + dim);
-            row_off += dim;
-        }
-        for _ in 0..width {
-            row_idx.extend_from_slice(&pattern);
-            col_ptr.push(row_idx.len());
-        }
-    }
-    (col_ptr, row_idx, blocks)
-}
-
-impl Factorization {
-    /// The symbolic LU factorization of the n × n pattern (`col_ptr`,
-    /// `row_idx`), with the scratch of the numeric factorization and solve.
-    fn new(n: usize, col_ptr: Vec<usize>, row_idx: Vec<usize>) -> Self {
-        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        // Supernodal: the pattern is made of dense 6×6 blocks; on the
-        // paper scene it factors 3.7 times faster than the simplicial
-        // variant faer picks by default.
-        let params = LuSymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        let symbolic = factorize_symbolic_lu(pattern.as_ref(), params)
-            .expect("symbolic LU of the contact pattern");
-        let req = StackReq::any_of(&[
-            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
-        ]);
-        Self {
-            pattern,
-            symbolic,
-            numeric: NumericLu::new(),
-            scratch: Scratch::new(req),
-        }
-    }
-}
-
 /// I_w = R·I_b·Rᵀ of body `i` at `state` [kg·m²].
 fn world_inertia(model: &Model, state: &State, i: usize) -> Mat3 {
     let r = state.rot[i].to_rotation_matrix();
     r.matrix() * Mat3::from_diagonal(&model.bodies[i].inertia) * r.matrix().transpose()
 }
 
-/// values(block) += scale · B_iᵀ·m·B_j.
-fn add_block(
-    values: &mut [f64],
-    col_ptr: &[usize],
-    blk: Block,
-    bi: Basis,
-    bj: Basis,
-    m: &Mat6,
-    scale: f64,
-) {
-    let at = |r: usize, c: usize| col_ptr[blk.col0 + c] + blk.row_off + r;
+/// B_iᵀ·m·B_j in the leading corner of a 6 × 6 block (the rest zero).
+fn project(bi: Basis, bj: Basis, m: &Mat6) -> Mat6 {
+    let mut out = Mat6::zeros();
     match (bi, bj) {
-        (Basis::Full, Basis::Full) => {
-            for c in 0..6 {
-                let base = at(0, c);
-                for r in 0..6 {
-                    values[base + r] += scale * m[(r, c)];
-                }
-            }
-        }
+        (Basis::Full, Basis::Full) => out = *m,
         (Basis::Full, Basis::Axis(u)) => {
             for r in 0..6 {
-                values[at(r, 0)] += scale * m.fixed_view::<1, 3>(r, 3).transpose().dot(&u);
+                out[(r, 0)] = m.fixed_view::<1, 3>(r, 3).transpose().dot(&u);
             }
         }
         (Basis::Axis(u), Basis::Full) => {
             for c in 0..6 {
-                values[at(0, c)] += scale * m.fixed_view::<3, 1>(3, c).dot(&u);
+                out[(0, c)] = m.fixed_view::<3, 1>(3, c).dot(&u);
             }
         }
         (Basis::Axis(u), Basis::Axis(w)) => {
-            values[at(0, 0)] += scale * u.dot(&(m.fixed_view::<3, 3>(3, 3) * w));
+            out[(0, 0)] = u.dot(&(m.fixed_view::<3, 3>(3, 3) * w));
         }
     }
+    out
 }

@@ -9,7 +9,9 @@
 //! ([`implicit`]) also see the Jacobian of the forces, through
 //! [`Dynamics::forces_and_jacobian`].
 
+mod blocklu;
 mod implicit;
+mod sparselu;
 
 pub use implicit::Stats;
 
