@@ -432,3 +432,22 @@ def test_cli_bad_options_exit_2_naming_option_and_value(tmp_path, capsys, argv, 
     assert err.startswith("ballcage: error: ") and needle in err
     assert len(err.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_time_left_scales_the_cost_per_step_of_the_nearest_finished_run():
+    from ballcage.studies.accuracy_run import _Outcome, _Plan, _time_left
+
+    runs = [
+        ("sdirk2", 1e-5, "reference"),
+        ("sdirk2", 2e-5, "reference-check"),
+        ("sdirk2", 1e-4, "run"),
+        ("rk4", 1e-6, "run"),
+    ]
+    plan = _Plan(runs, [], 1e-3, 1.0, [])
+    done = [_Outcome("sdirk2", 1e-5, "reference", {}, 10.0, {}, False, None)]
+    # The sdirk2 runs take 10 s × 1e-5 / dt (half and a tenth of the steps); rk4 has no finished
+    # run, so the reference's cost per step applies to its 10× more steps.
+    assert _time_left(plan, done) == pytest.approx(5.0 + 1.0 + 100.0)
+    done.append(_Outcome("sdirk2", 2e-5, "reference-check", {}, 4.0, {}, False, None))
+    # Now the 1e-4 run scales the nearer 2e-5 run: 4 s × 0.2.
+    assert _time_left(plan, done) == pytest.approx(0.8 + 100.0)

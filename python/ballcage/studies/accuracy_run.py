@@ -180,8 +180,8 @@ def _estimate(plan: _Plan) -> str:
 
 
 def _time_left(plan: _Plan, outcomes: Sequence[_Outcome]) -> float:
-    """Wall time [s] the runs after `outcomes` should take, at the cost per simulated second of the
-    finished run nearest in step with the same integrator (else of the reference)."""
+    """Wall time [s] the runs after `outcomes` should take, at the cost per step of the finished
+    run nearest in step with the same integrator (else of the reference)."""
     left = 0.0
     for integrator, dt, _ in plan.runs[len(outcomes) :]:
         same = [o for o in outcomes if o.integrator == integrator and not o.diverged] or [outcomes[0]]
@@ -192,7 +192,6 @@ def _time_left(plan: _Plan, outcomes: Sequence[_Outcome]) -> float:
 
 def _minutes(seconds: float) -> str:
     return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min"
-
 
 
 @dataclass
