@@ -1,5 +1,6 @@
 //! Runs the paper scene for a short time and prints stability and cost figures.
-//! Usage: cargo run --release --example probe -- DT INTEGRATOR DURATION
+//! Usage: [PROBE_WARM=T] cargo run --release --example probe -- DT INTEGRATOR DURATION [KEY=VALUE ...]
+//! (PROBE_WARM: run to T s first, then DURATION s inside `window`, for callgrind)
 use ballcage_core::Document;
 use std::time::Instant;
 

@@ -18,8 +18,8 @@
 //! Its maxima are the rims and the interior points where |u| stops growing:
 //! since u is perpendicular to the centreline at the nearest point,
 //! d|u|²/ds = 2 u·â exactly (â the link axis), so a maximum lies between two
-//! samples where u·â changes from positive to negative. There a
-//! golden-section search finds it to round-off, so the largest penetration
+//! samples where u·â changes from positive to negative. There regula falsi
+//! (Illinois) on u·â finds it to round-off, so the largest penetration
 //! of a patch is exact, and a patch lying wholly between two samples (a
 //! straight link against the convex inner wall of a bend) is not missed.
 //! The `points` samples along the axis (rims included) locate the patches: a
@@ -360,6 +360,19 @@ mod tests {
             let rim = ((h + 0.043).powi(2) + 0.04_f64).sqrt() - 0.5 - 0.058;
             assert_relative_eq!(out[0].depth, rim, epsilon = 1e-9);
             assert_relative_eq!(out[2].depth, rim, epsilon = 1e-9);
+        }
+        // The same chord slid 10 mm along its axis: the deepest point stays at
+        // the foot of the perpendicular from O, now off the middle of the
+        // samples bracketing it, and is still found exactly, where it is.
+        let along = Vec3::new(-radial.z, 0.0, radial.x);
+        for points in [4, 6] {
+            let out = contacts(&tube, 0.2, points, (centre + 0.01 * along, q));
+            let middle = out
+                .iter()
+                .find(|c| c.normal.dot(&radial) > 0.99)
+                .expect("the inner-wall patch");
+            assert_relative_eq!(middle.depth, 1e-4, epsilon = 1e-9);
+            assert_relative_eq!((middle.point - centre).dot(&along), 0.0, epsilon = 1e-6);
         }
     }
 }
