@@ -1,4 +1,4 @@
-//! Whole-simulation benchmarks: integrator steps of small scenes.
+//! Whole-simulation benchmarks: small scenes, and the paper scene per step and per 0.1 s run.
 
 use ballcage_core::{Document, Scene, Simulation};
 use criterion::{Criterion, criterion_group, criterion_main};
@@ -30,36 +30,63 @@ fn scene(n: usize) -> Scene {
     Scene::from_toml_str(&toml, &[]).expect("valid bench scene")
 }
 
+/// The paper's scene with `hinge` and `integrator` (ball keys at the
+/// scene's default step, ideal CV at 1 ms), `solver` and `duration` [s].
+fn paper_scene(hinge: &str, integrator: &str, solver: &str, duration: f64) -> (Document, f64) {
+    let mut set = vec![
+        format!("pipe.hinge=\"{hinge}\""),
+        format!("simulation.integrator=\"{integrator}\""),
+        format!("simulation.newton.linear_solver=\"{solver}\""),
+        format!("simulation.duration={duration}"),
+        "record.tables=[]".to_string(),
+    ];
+    if hinge == "ideal-cv" {
+        set.push("simulation.dt=1e-3".to_string());
+    }
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &set).expect("valid paper scene");
+    let dt = doc.scene().simulation.dt;
+    (doc, dt)
+}
+
+const HINGES: [&str; 2] = ["ball-keys", "ideal-cv"];
+const INTEGRATORS: [&str; 2] = ["linearly-implicit-euler", "sdirk2"];
+
 /// The paper's drill pipe (12 joints; ball keys: 106 bodies, 519 pairs;
-/// ideal CV: 15 bodies) for 20 ms from rest, with each implicit integrator
-/// at its step and each linear solver: block elimination along the bodies'
-/// graph (the default) against faer's general sparse LU.
-fn paper(c: &mut Criterion) {
-    let mut g = c.benchmark_group("paper scene, first 20 ms");
+/// ideal CV: 15 bodies) for 0.1 s from rest, with each implicit integrator
+/// and each linear solver: block elimination along the bodies' graph (the
+/// default) against faer's general sparse LU.
+fn paper_run(c: &mut Criterion) {
+    let mut g = c.benchmark_group("paper scene, 0.1 s from rest");
     g.sample_size(10);
-    for hinge in ["ball-keys", "ideal-cv"] {
-        for (integrator, dt) in [("linearly-implicit-euler", 1e-4), ("sdirk2", 1e-4)] {
+    for hinge in HINGES {
+        for integrator in INTEGRATORS {
             for solver in ["block-elimination", "sparse-lu"] {
-                let s = Document::from_toml_str(
-                    "kind = \"drill-pipe\"\n",
-                    &[
-                        format!("pipe.hinge=\"{hinge}\""),
-                        format!("simulation.integrator=\"{integrator}\""),
-                        format!("simulation.dt={dt}"),
-                        format!("simulation.newton.linear_solver=\"{solver}\""),
-                        "simulation.duration=0.02".to_string(),
-                        "record.tables=[]".to_string(),
-                    ],
-                )
-                .expect("valid paper scene");
+                let (doc, dt) = paper_scene(hinge, integrator, solver, 0.1);
                 g.bench_function(format!("{hinge}, {integrator} at {dt} s, {solver}"), |b| {
                     b.iter(|| {
-                        let mut sim = s.simulation();
+                        let mut sim = doc.simulation();
                         sim.run().expect("stable");
                         sim.steps()
                     })
                 });
             }
+        }
+    }
+    g.finish();
+}
+
+/// One step of the same scenes in the loaded phase: each iteration steps
+/// on from t = 0.5 s (the chain folded, the drive at speed and loaded).
+fn paper_step(c: &mut Criterion) {
+    let mut g = c.benchmark_group("paper scene, one step from t = 0.5 s");
+    for hinge in HINGES {
+        for integrator in INTEGRATORS {
+            let (doc, dt) = paper_scene(hinge, integrator, "block-elimination", 100.0);
+            let mut sim = doc.simulation();
+            sim.advance_to(0.5).expect("stable warm-up");
+            g.bench_function(format!("{hinge}, {integrator} at {dt} s"), |b| {
+                b.iter(|| sim.step().expect("stable"))
+            });
         }
     }
     g.finish();
@@ -81,5 +108,5 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, paper);
+criterion_group!(benches, bench, paper_step, paper_run);
 criterion_main!(benches);

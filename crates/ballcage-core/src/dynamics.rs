@@ -13,6 +13,7 @@ use crate::force::joint::twist_axis;
 use crate::geometry::ContactPoint;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
+use rayon::prelude::*;
 
 /// Accelerations of every body (zero for bodies that are not integrated).
 #[derive(Debug, Clone, PartialEq)]
@@ -110,12 +111,24 @@ impl Energy {
     }
 }
 
+/// One pair's contact points with their laws evaluated, kept until they are
+/// summed in the pairs' order.
+#[derive(Debug, Clone, Default)]
+struct PairEval {
+    points: Vec<ContactPoint>,
+    evals: Vec<(ContactEval, PointDerivatives)>,
+}
+
 /// Force evaluator with its scratch space and per-contact memory.
 #[derive(Debug, Clone)]
 pub struct Dynamics {
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
     points: Vec<ContactPoint>,
+    /// Per pair: its points of the current evaluation.
+    pairs: Vec<PairEval>,
+    /// Threads that evaluate the pairs (`None`: this thread alone).
+    pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     /// Latched approach speed per pair and slot [m/s]; empty for laws that do not latch.
     latched: Vec<Vec<Option<f64>>>,
     /// Number of force evaluations so far.
@@ -225,6 +238,27 @@ impl Dynamics {
             force: vec![Vec3::zeros(); n],
             torque: vec![Vec3::zeros(); n],
             points: Vec::with_capacity(16),
+            // Room for as many points as each pair can report: no
+            // allocation when a pair first comes into contact.
+            pairs: model
+                .pairs
+                .iter()
+                .map(|p| PairEval {
+                    points: Vec::with_capacity(p.geometry.slots()),
+                    evals: Vec::with_capacity(p.geometry.slots()),
+                })
+                .collect(),
+            // A pool that cannot start leaves the evaluation on this thread:
+            // the same results, only slower.
+            pool: (model.threads > 1)
+                .then(|| {
+                    rayon::ThreadPoolBuilder::new()
+                        .num_threads(model.threads)
+                        .build()
+                        .ok()
+                })
+                .flatten()
+                .map(std::sync::Arc::new),
             latched: model
                 .pairs
                 .iter()
@@ -307,43 +341,59 @@ impl Dynamics {
                 jac.add_joint(model.pairs.len() + n, j, state, &ra, &rb);
             }
         }
-        // 3. contacts
-        for k in 0..model.pairs.len() {
-            self.contacts(model, state, mode, k, jac.as_deref_mut());
+        // 3. contacts: each pair on its own (in parallel with a pool), then
+        // summed in the pairs' order, so that the result does not depend on
+        // the number of threads.
+        let n = model.pairs.len();
+        let scale = jac.as_ref().map_or(0.0, |j| j.stiffness_scale);
+        let one = |k: usize, e: &mut PairEval, l: &mut Vec<Option<f64>>, c| {
+            evaluate_pair(model, state, mode, k, e, l, c, scale)
+        };
+        let (pairs, latched) = (&mut self.pairs, &mut self.latched);
+        match (&self.pool, jac) {
+            (None, None) => {
+                for (k, (e, l)) in pairs.iter_mut().zip(latched).enumerate() {
+                    one(k, e, l, None);
+                }
+            }
+            (None, Some(jac)) => {
+                let cs = jac.couplings[..n].iter_mut();
+                for (k, ((e, l), c)) in pairs.iter_mut().zip(latched).zip(cs).enumerate() {
+                    one(k, e, l, Some(c));
+                }
+            }
+            (Some(pool), None) => pool.install(|| {
+                pairs
+                    .par_iter_mut()
+                    .zip(latched.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(k, (e, l))| one(k, e, l, None))
+            }),
+            (Some(pool), Some(jac)) => pool.install(|| {
+                pairs
+                    .par_iter_mut()
+                    .zip(latched.par_iter_mut())
+                    .zip(jac.couplings[..n].par_iter_mut())
+                    .enumerate()
+                    .for_each(|(k, ((e, l), c))| one(k, e, l, Some(c)))
+            }),
+        }
+        for (k, (pair, e)) in model.pairs.iter().zip(&self.pairs).enumerate() {
+            for (e, d) in &e.evals {
+                self.watch.see(k, pair, e, d);
+                let (f, p) = (e.force(), e.point.point);
+                let (a, b) = (pair.a, pair.b);
+                self.force[b] += f;
+                self.torque[b] += (p - state.pos[b]).cross(&f);
+                self.force[a] -= f;
+                self.torque[a] -= (p - state.pos[a]).cross(&f);
+            }
         }
     }
 
-    /// Stage 3 for pair `k`: finds its points, latches onsets in
-    /// [`Mode::Commit`], evaluates the laws and adds the forces (and, with
-    /// `jac`, their Jacobian).
-    fn contacts(
-        &mut self,
-        model: &Model,
-        state: &State,
-        mode: Mode,
-        k: usize,
-        mut jac: Option<&mut VelocityJacobian>,
-    ) {
-        let pair = &model.pairs[k];
-        let mut points = std::mem::take(&mut self.points);
-        find_points(model, pair, state, &mut points);
-        if mode == Mode::Commit {
-            latch(&mut self.latched[k], state, pair, &points);
-        }
-        for p in &points {
-            let (e, d) = evaluate_point_full(state, pair, p, &self.latched[k]);
-            self.watch.see(k, pair, &e, &d);
-            let f = e.force();
-            let (a, b) = (pair.a, pair.b);
-            self.force[b] += f;
-            self.torque[b] += (p.point - state.pos[b]).cross(&f);
-            self.force[a] -= f;
-            self.torque[a] -= (p.point - state.pos[a]).cross(&f);
-            if let Some(jac) = jac.as_deref_mut() {
-                jac.add_contact_point(k, state, pair, &e, &d);
-            }
-        }
-        self.points = points;
+    /// Threads evaluating the contact pairs (1 without a pool).
+    pub fn threads(&self) -> usize {
+        self.pool.as_ref().map_or(1, |p| p.current_num_threads())
     }
 
     /// Whether some pair keeps per-contact memory (latched approach speeds),
@@ -450,6 +500,35 @@ impl Dynamics {
             potential_gravity,
             potential_contact,
         }
+    }
+}
+
+/// Stage 3 for pair `k`, on its own: finds its points, latches onsets in
+/// [`Mode::Commit`], evaluates the laws into `e` and, with `c`, fills the
+/// pair's Jacobian blocks (stiffness weight `scale`).
+#[allow(clippy::too_many_arguments)]
+fn evaluate_pair(
+    model: &Model,
+    state: &State,
+    mode: Mode,
+    k: usize,
+    e: &mut PairEval,
+    latched: &mut [Option<f64>],
+    mut c: Option<&mut CouplingJacobian>,
+    scale: f64,
+) {
+    let pair = &model.pairs[k];
+    find_points(model, pair, state, &mut e.points);
+    if mode == Mode::Commit {
+        latch(latched, state, pair, &e.points);
+    }
+    e.evals.clear();
+    for p in &e.points {
+        let (ev, d) = evaluate_point_full(state, pair, p, latched);
+        if let Some(c) = c.as_deref_mut() {
+            c.add_contact_point(state, pair, &ev, &d, scale);
+        }
+        e.evals.push((ev, d));
     }
 }
 
@@ -598,6 +677,35 @@ pub struct CouplingJacobian {
     pub bb: Mat6,
 }
 
+impl CouplingJacobian {
+    /// Adds the blocks of force G·v_rel acting on b at arm `r_b` (and its
+    /// reaction on a at arm `r_a`), v_rel the velocity of b's point relative
+    /// to a's.
+    fn add_gradient(&mut self, g: &Mat3, r_a: &Vec3, r_b: &Vec3) {
+        self.active = true;
+        self.bb += wrench_twist_block(r_b, g, r_b);
+        self.ba -= wrench_twist_block(r_b, g, r_a);
+        self.ab -= wrench_twist_block(r_a, g, r_b);
+        self.aa += wrench_twist_block(r_a, g, r_a);
+    }
+
+    /// Adds contact point `e` of `pair` (stiffness weight `scale`).
+    fn add_contact_point(
+        &mut self,
+        state: &State,
+        pair: &ContactPair,
+        e: &ContactEval,
+        d: &PointDerivatives,
+        scale: f64,
+    ) {
+        let g = contact_velocity_gradient(e, d, scale);
+        if g != Mat3::zeros() {
+            let p = e.point.point;
+            self.add_gradient(&g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
+        }
+    }
+}
+
 /// D = ∂f/∂(twist): the velocity Jacobian of all joint and contact forces,
 /// in 6×6 blocks. The sparsity pattern is fixed by the model: entry `k` of
 /// [`VelocityJacobian::couplings`] is contact pair `k` for
@@ -672,31 +780,9 @@ impl VelocityJacobian {
         d
     }
 
-    /// Adds the blocks of force G·v_rel acting on b at arm `r_b` (and its
-    /// reaction on a at arm `r_a`), v_rel the velocity of b's point relative
-    /// to a's.
+    /// [`CouplingJacobian::add_gradient`] of coupling `k`.
     fn add_gradient(&mut self, k: usize, g: &Mat3, r_a: &Vec3, r_b: &Vec3) {
-        let c = &mut self.couplings[k];
-        c.active = true;
-        c.bb += wrench_twist_block(r_b, g, r_b);
-        c.ba -= wrench_twist_block(r_b, g, r_a);
-        c.ab -= wrench_twist_block(r_a, g, r_b);
-        c.aa += wrench_twist_block(r_a, g, r_a);
-    }
-
-    fn add_contact_point(
-        &mut self,
-        k: usize,
-        state: &State,
-        pair: &ContactPair,
-        e: &ContactEval,
-        d: &PointDerivatives,
-    ) {
-        let g = contact_velocity_gradient(e, d, self.stiffness_scale);
-        if g != Mat3::zeros() {
-            let p = e.point.point;
-            self.add_gradient(k, &g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
-        }
+        self.couplings[k].add_gradient(g, r_a, r_b);
     }
 
     /// The joint's dampers: −c·(v_b(p_b) − v_a(p_a)) at the hinge points

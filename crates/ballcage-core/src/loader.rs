@@ -356,7 +356,7 @@ fn named_unit(key: &str) -> Option<&'static str> {
             &["duration", "dt", "output_interval", "ramp", "spin_ramp"],
             "s",
         ),
-        (&["joints", "tube_contact_points", "points"], "-"),
+        (&["joints", "tube_contact_points", "points", "threads"], "-"),
         (&["twist_stiffness", "stop_stiffness"], "N·m/rad"),
         (&["twist_damping"], "N·m·s/rad"),
         (&["stiffness"], "N/m"),

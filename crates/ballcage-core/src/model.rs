@@ -227,6 +227,9 @@ pub struct Model {
     pub integrator: IntegratorKind,
     /// Integrator step [s].
     pub dt: f64,
+    /// Threads of a force evaluation's contact pairs
+    /// ([`crate::scene::SimulationSpec::threads`], 0 resolved to the cores).
+    pub threads: usize,
     /// Newton iterations of the `sdirk2` integrator.
     pub newton: crate::scene::NewtonSpec,
     /// Largest energy the integrator may create, as a fraction of the

@@ -109,6 +109,11 @@ impl Simulation {
         }
     }
 
+    /// Threads evaluating the contact pairs (`simulation.threads`).
+    pub fn threads(&self) -> usize {
+        self.dynamics.threads()
+    }
+
     /// The assembled model.
     pub fn model(&self) -> &Model {
         &self.model

@@ -55,6 +55,10 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         integrator: scene.simulation.integrator,
         dt: scene.simulation.dt,
         newton: scene.simulation.newton.clone(),
+        threads: match scene.simulation.threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n as usize,
+        },
         energy_growth: scene.simulation.divergence.energy_growth,
         steps_per_output: scene.steps_per_output(),
         total_steps: scene.total_steps(),

@@ -398,6 +398,7 @@ impl Default for DrillPipeSpec {
                 integrator: IntegratorKind::Sdirk2,
                 newton: NewtonSpec::default(),
                 divergence: DivergenceSpec::default(),
+                threads: 1,
             },
             world: GravitySpec::default(),
             borehole: BoreholeSpec::default(),

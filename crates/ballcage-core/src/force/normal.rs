@@ -183,6 +183,13 @@ pub fn hertz_stiffness(
     4.0 / 3.0 * e_star * r_star.sqrt()
 }
 
+/// K·δⁿ and its slope n·K·δⁿ⁻¹, δ > 0, from one power.
+#[inline]
+fn power_law(stiffness: f64, depth: f64, n: f64) -> (f64, f64) {
+    let slope = stiffness * depth.powf(n - 1.0);
+    (slope * depth, n * slope)
+}
+
 /// MSC Adams IMPACT law (penetration form):
 /// F = max(0, K δⁿ + STEP(δ, 0, 0, d_max, c_max) δ̇).
 pub fn impact_normal_force(depth: f64, rate: f64, p: &ImpactParams) -> NormalForce {
@@ -190,8 +197,7 @@ pub fn impact_normal_force(depth: f64, rate: f64, p: &ImpactParams) -> NormalFor
         return NormalForce::default();
     }
     let n = p.exponent;
-    let elastic = p.stiffness * depth.powf(n);
-    let d_elastic = n * p.stiffness * depth.powf(n - 1.0);
+    let (elastic, d_elastic) = power_law(p.stiffness, depth, n);
     let (c, dc) = step(depth, 0.0, 0.0, p.depth_max, p.damping);
     NormalForce::clamped(elastic + c * rate, d_elastic + dc * rate, c)
 }
@@ -210,8 +216,7 @@ fn dissipative_normal_force(
     }
     let n = p.exponent;
     let v_minus = approach_speed.max(p.min_approach_speed);
-    let elastic = p.stiffness * depth.powf(n);
-    let d_elastic = n * p.stiffness * depth.powf(n - 1.0);
+    let (elastic, d_elastic) = power_law(p.stiffness, depth, n);
     let damping_ratio = chi / v_minus;
     let factor = 1.0 + damping_ratio * rate;
     NormalForce::clamped(

@@ -75,18 +75,38 @@ fn plane_basis(e: &Vec3) -> (Vec3, Vec3) {
     (e1, e.cross(&e1))
 }
 
+/// (cos, sin) of k·30°, k = 0‥11.
+const TWELFTHS: [(f64, f64); 12] = {
+    const H: f64 = 0.866_025_403_784_438_6; // √3/2
+    [
+        (1.0, 0.0),
+        (H, 0.5),
+        (0.5, H),
+        (0.0, 1.0),
+        (-0.5, H),
+        (-H, 0.5),
+        (-1.0, 0.0),
+        (-H, -0.5),
+        (-0.5, -H),
+        (0.0, -1.0),
+        (0.5, -H),
+        (H, -0.5),
+    ]
+};
+
 /// The ring angle φ* whose point is nearest the axis (P, â): Newton on
 /// g′(φ) = 0 from the best of 12 samples, so that the start lies in the
 /// basin of the global minimum.
 fn nearest_to_axis(o: &Vec3, e1: &Vec3, e2: &Vec3, rho: f64, p: &Vec3, a: &Vec3) -> f64 {
-    let g = |phi: f64| {
-        let w = o + rho * (phi.cos() * e1 + phi.sin() * e2) - p;
+    // The samples at k·30° from a table of (cos, sin), not from sin_cos.
+    let sample = |(c, s): (f64, f64)| {
+        let w = o + rho * (c * e1 + s * e2) - p;
         w.norm_squared() - w.dot(a).powi(2)
     };
-    let mut phi = (0..12)
-        .map(|k| k as f64 * std::f64::consts::TAU / 12.0)
-        .min_by(|x, y| g(*x).total_cmp(&g(*y)))
-        .unwrap_or(0.0);
+    let k = (0..12)
+        .min_by(|&i, &j| sample(TWELFTHS[i]).total_cmp(&sample(TWELFTHS[j])))
+        .unwrap_or(0);
+    let mut phi = k as f64 * std::f64::consts::TAU / 12.0;
     for _ in 0..20 {
         let (s, c) = phi.sin_cos();
         let w = o + rho * (c * e1 + s * e2) - p;

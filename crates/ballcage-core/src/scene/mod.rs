@@ -232,6 +232,16 @@ pub struct SimulationSpec {
     /// Divergence detection.
     #[serde(default)]
     pub divergence: DivergenceSpec,
+    /// Threads that evaluate the contact pairs of one force evaluation in
+    /// parallel [–]. Each pair's points, laws and Jacobian blocks are
+    /// computed on their own and summed in the pairs' order, so results are
+    /// bitwise identical for any count. Default 1; 0 takes one per core.
+    #[serde(default = "one_thread")]
+    pub threads: u32,
+}
+
+fn one_thread() -> u32 {
+    1
 }
 
 impl SimulationSpec {
