@@ -341,15 +341,28 @@ impl Dynamics {
                 jac.add_joint(model.pairs.len() + n, j, state, &ra, &rb);
             }
         }
-        // 3. contacts: each pair on its own (in parallel with a pool), then
-        // summed in the pairs' order, so that the result does not depend on
-        // the number of threads.
+        // 3. contacts
+        self.contacts(model, state, mode, jac);
+    }
+
+    /// Stage 3: each pair on its own (in parallel with a pool), then summed
+    /// in the pairs' order, so that the result does not depend on the
+    /// number of threads.
+    fn contacts(
+        &mut self,
+        model: &Model,
+        state: &State,
+        mode: Mode,
+        jac: Option<&mut VelocityJacobian>,
+    ) {
         let n = model.pairs.len();
         let scale = jac.as_ref().map_or(0.0, |j| j.stiffness_scale);
         let one = |k: usize, e: &mut PairEval, l: &mut Vec<Option<f64>>, c| {
             evaluate_pair(model, state, mode, k, e, l, c, scale)
         };
         let (pairs, latched) = (&mut self.pairs, &mut self.latched);
+        // A few tasks per thread: enough to balance, few enough to be cheap.
+        let chunk = n.div_ceil(4 * self.pool.as_ref().map_or(1, |p| p.current_num_threads()));
         match (&self.pool, jac) {
             (None, None) => {
                 for (k, (e, l)) in pairs.iter_mut().zip(latched).enumerate() {
@@ -367,6 +380,7 @@ impl Dynamics {
                     .par_iter_mut()
                     .zip(latched.par_iter_mut())
                     .enumerate()
+                    .with_min_len(chunk)
                     .for_each(|(k, (e, l))| one(k, e, l, None))
             }),
             (Some(pool), Some(jac)) => pool.install(|| {
@@ -375,6 +389,7 @@ impl Dynamics {
                     .zip(latched.par_iter_mut())
                     .zip(jac.couplings[..n].par_iter_mut())
                     .enumerate()
+                    .with_min_len(chunk)
                     .for_each(|(k, ((e, l), c))| one(k, e, l, Some(c)))
             }),
         }
