@@ -57,9 +57,17 @@ class SceneBuilder:
         dt: float | None = None,
         output_interval: float | None = None,
         integrator: str | None = None,
+        threads: int | None = None,
     ) -> Self:
-        """Time stepping: `duration`, `dt` and `output_interval` [s], `integrator` name."""
-        given = {"duration": duration, "dt": dt, "output_interval": output_interval, "integrator": integrator}
+        """Time stepping: `duration`, `dt` and `output_interval` [s], `integrator` name, and
+        `threads` evaluating the contact pairs (default 1; results are bitwise the same for any count)."""
+        given = {
+            "duration": duration,
+            "dt": dt,
+            "output_interval": output_interval,
+            "integrator": integrator,
+            "threads": threads,
+        }
         self._scene["simulation"].update({k: v for k, v in given.items() if v is not None})
         return self
 
@@ -147,7 +155,7 @@ class DrillPipeBuilder:
         return self
 
     def simulation(self, **fields: Any) -> Self:
-        """`duration`, `dt`, `output_interval` [s], `integrator`."""
+        """`duration`, `dt`, `output_interval` [s], `integrator`, `threads`."""
         return self._section("simulation", fields)
 
     def world(self, **fields: Any) -> Self:
