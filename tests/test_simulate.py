@@ -176,7 +176,8 @@ def test_debug_build_warns_on_import():
 def test_public_api_is_curated():
     assert set(ballcage.__all__) == {
         "DrillPipeBuilder", "Run", "Scene", "SceneBuilder", "SceneError", "Simulation", "SimulationError",
-        "__version__", "buckling", "load_scene", "simulate", "table_schema",
+        "__version__", "buckling", "largest_joint_diameter", "load_scene", "longest_joint", "simulate",
+        "smallest_curvature_radius", "table_schema",
     }
     assert issubclass(ballcage.SceneError, ValueError)
     assert issubclass(ballcage.SimulationError, RuntimeError)

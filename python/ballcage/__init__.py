@@ -15,6 +15,7 @@ All quantities are SI; units are in each output column's field metadata.
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
 `ballcage.paper.run_paper(dir)` runs it and writes the tables, the paper's
 figures and a comparison with the paper's numbers (``ballcage paper``).
+`ballcage.sizing` is the paper's joint-sizing eq. (9) both ways (``ballcage size``).
 `ballcage.studies.accuracy` and `ballcage.studies.stability` measure what
 each integrator's step costs in error and where it stops being stable
 (``ballcage accuracy``, ``ballcage stability``).
@@ -29,6 +30,7 @@ from ballcage._native import Scene, SceneError, Simulation, SimulationError, tab
 from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
+from ballcage.sizing import largest_joint_diameter, longest_joint, smallest_curvature_radius
 
 __version__: str = _native.__version__
 
@@ -42,8 +44,11 @@ __all__ = [
     "SimulationError",
     "__version__",
     "buckling",
+    "largest_joint_diameter",
     "load_scene",
+    "longest_joint",
     "simulate",
+    "smallest_curvature_radius",
     "table_schema",
 ]
 
@@ -63,4 +68,6 @@ def __getattr__(name: str) -> _Any:
     """Imports `ballcage.paper` and `ballcage.studies` (and with them matplotlib) only when first used."""
     if name in ("paper", "studies"):
         return _importlib.import_module(f"ballcage.{name}")
+    if name == "sweep":  # `ballcage.sweep(spec, out, client=...)`: ballcage.studies.sweep_run.sweep
+        return _importlib.import_module("ballcage.studies.sweep_run").sweep
     raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

@@ -22,6 +22,10 @@ __all__ = [
     "integrator_facts",
     "table_schema",
     "whole_multiple",
+    "longest_link",
+    "tightest_radius_for_link",
+    "largest_link_radius",
+    "tightest_radius_for_bend",
 ]
 
 _TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive", "pairs"]
@@ -189,3 +193,24 @@ def whole_multiple(interval: float, step: float) -> int | None:
 
 def default_scene_toml() -> str:
     """The embedded default scene (the paper's drill pipe, ``kind = "drill-pipe"``) as TOML, every default written out."""
+
+def longest_link(curvature_radius: float, tube_diameter: float, link_radius: float) -> float:
+    """The paper's eq. (9): the longest rigid link [m] of radius `link_radius` [m] that fits a tube of
+    inner diameter `tube_diameter` [m] bent to centreline radius `curvature_radius` [m],
+    L = 2·√(2(D − 2r)(R + r)). Use `ballcage.sizing` (diameters, argument checks).
+    """
+
+def tightest_radius_for_link(length: float, tube_diameter: float, link_radius: float) -> float:
+    """Eq. (9) solved for R: the tightest centreline radius [m] a rigid link of `length` [m] fits,
+    R = (L/2)² / (2(D − 2r)) − r; ``inf`` when the link does not fit the straight tube.
+    """
+
+def largest_link_radius(length: float, curvature_radius: float, tube_diameter: float) -> float | None:
+    """Eq. (9) solved for r: the largest radius [m] of a rigid link of `length` [m] that fits,
+    r = (D − 2R + √((2R + D)² − L²)) / 4; ``None`` when no link that long fits, L > 2·√(2RD).
+    """
+
+def tightest_radius_for_bend(pitch: float, bend_limit: float) -> float:
+    """The tightest centreline radius [m] at which hinges `pitch` [m] apart bend by `bend_limit` [rad]:
+    R = p / (2 sin(β / 2)).
+    """

@@ -74,8 +74,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail("interrupted", 130)
 
 
+#: `ballcage size` options, all lengths in mm.
+_SIZE_OPTIONS = ("--radius", "--tube-id", "--joint-od", "--length")
 #: Options whose value may be a (wrong) negative number, which argparse would take for an option.
-_NUMBER_OPTIONS = frozenset({"--steps", "--reference-dt", "--duration", "--values-per-parameter", "--bisections"})
+_NUMBER_OPTIONS = frozenset(
+    {"--steps", "--reference-dt", "--duration", "--values-per-parameter", "--bisections", *_SIZE_OPTIONS}
+)
 
 
 def _attach_negative_numbers(argv: Sequence[str]) -> list[str]:
@@ -105,6 +109,8 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_scene_command(commands)
     _add_schema_command(commands)
     _add_buckling_command(commands)
+    _add_size_command(commands)
+    _add_sweep_command(commands)
     return parser
 
 
@@ -287,10 +293,115 @@ def _add_schema_command(commands: _Commands) -> None:
     schema.set_defaults(command=_schema)
 
 
+def _add_sweep_command(commands: _Commands) -> None:
+    sweep = commands.add_parser(
+        "sweep",
+        help="run a grid or a list of scene variants in parallel (locally or on Dask); one summary row per case",
+        description=(
+            "Run every case of a sweep file (a [grid] of dotted scene keys, their Cartesian product, and/or [[case]] "
+            "tables of overrides, on a base scene; docs/studies.md) in parallel. Writes DIR/<table>/case=NNNN/"
+            "part.parquet (hive-partitioned datasets), DIR/summary.parquet (one row per case: parameters, derived "
+            "quantities, status, cost) and DIR/plots/<parameter>.png. A diverging case is recorded and the sweep goes "
+            "on; running the same command again resumes, skipping finished cases. Exit code 1 when a case did not finish."
+        ),
+    )
+    sweep.add_argument("sweep", metavar="SWEEP.toml", help="sweep file (TOML), e.g. examples/sweeps/curvature_rpm.toml")
+    _add_out_option(sweep)
+    sweep.add_argument("--workers", metavar="N", type=_workers, help="local threads running cases (default: one per CPU)")
+    sweep.add_argument(
+        "--scheduler", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS (tcp://host:8786); needs ballcage[dask]"
+    )
+    sweep.add_argument("--retry-failed", action="store_true", help="also run again the cases that diverged or failed")
+    sweep.add_argument("--no-plots", action="store_true", help="do not draw DIR/plots/*.png")
+    _add_quiet_option(sweep, "no progress and no summary lines")
+    sweep.set_defaults(command=_sweep)
+
+
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: not a whole number") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text}: must be at least 1")
+    return value
+
+
+def _sweep(args: argparse.Namespace) -> int:
+    from ballcage.studies.sweep_run import command  # deferred: pyarrow, numpy, matplotlib
+    from ballcage.studies.sweep_spec import SweepError
+
+    try:
+        return command(args)
+    except SweepError as e:
+        raise UsageError(str(e)) from e
+
+
 def _add_buckling_command(commands: _Commands) -> None:
     from ballcage.buckling import add_command  # the command lives with its model (docs/buckling.md)
 
     add_command(commands)
+
+
+def _add_size_command(commands: _Commands) -> None:
+    size = commands.add_parser(
+        "size",
+        help="joint sizing by the paper's eq. (9), in mm: longest joint, tightest bend or widest joint",
+        description=(
+            "The paper's eq. (8)-(9) for a rigid joint in a bent guide tube, lengths in mm. Give --tube-id and two "
+            "of --radius, --joint-od and --length; it prints the third: --radius and --joint-od the longest joint, "
+            "--length and --joint-od the smallest curvature radius, --length and --radius the largest joint OD. "
+            "--plot draws the longest joint against the curvature radius for several joint diameters (the "
+            "paper's Figure 15; --tube-id, default 116). It checks the fit in the tube only; the hinge's "
+            "articulation limit binds first for the paper's pipe (ballcage.Scene.tightest_radius)."
+        ),
+    )
+    for option, what in (
+        ("--radius", "curvature radius R of the tube's centreline"),
+        ("--tube-id", "inner diameter D of the guide tube"),
+        ("--joint-od", "outer diameter d = 2r of the joint"),
+        ("--length", "length L of the joint"),
+    ):
+        size.add_argument(option, metavar="MM", help=f"{what} [mm]")
+    size.add_argument("--plot", metavar="FILE.png", type=Path, help="also write a PNG of the eq. (9) curves")
+    size.set_defaults(command=_size)
+
+
+def _size(args: argparse.Namespace) -> int:
+    from ballcage import sizing  # deferred with the rest of the subcommands' modules
+
+    mm = {o: _positive(o, getattr(args, o[2:].replace("-", "_")), "a positive length in mm") for o in _SIZE_OPTIONS}
+    given = [o for o in ("--radius", "--joint-od", "--length") if mm[o] is not None]
+    if len(given) in (1, 3) or (not given and args.plot is None):
+        raise UsageError(f"give --tube-id and two of --radius, --joint-od and --length (got {', '.join(given) or 'none'})")
+    if len(given) == 2 and mm["--tube-id"] is None:
+        raise UsageError(f"--tube-id missing: {' and '.join(given)} need the tube's inner diameter in mm")
+    tube = mm["--tube-id"] or 1e3 * sizing.PAPER_TUBE_INNER_DIAMETER
+    joint, radius, length = mm["--joint-od"], mm["--radius"], mm["--length"]
+    if joint is not None and joint >= tube:
+        raise UsageError(f"--joint-od {args.joint_od}: not narrower than the bore, --tube-id {tube:g}")
+    if radius is not None and radius < tube / 2:
+        raise UsageError(f"--radius {args.radius}: below half the bore ({tube / 2:g} mm); a tube cannot bend that tightly")
+    if joint is not None and radius is not None:
+        length = 1e3 * sizing.longest_joint(radius / 1e3, tube / 1e3, joint / 1e3)
+        print(f"{length:.2f}")
+    elif joint is not None and length is not None:
+        radius = 1e3 * sizing.smallest_curvature_radius(length / 1e3, tube / 1e3, joint / 1e3)
+        print(f"{radius:.2f}")
+    elif radius is not None and length is not None:
+        most = 1e3 * _native.longest_link(radius / 1e3, tube / 1e3, 0.0)
+        if length >= most:
+            raise UsageError(
+                f"--length {args.length}: no joint that long fits a {tube:g} mm bore bent to R = {radius:g} mm "
+                f"(eq. (9): under {most:.2f} mm, the length of a joint of no diameter)"
+            )
+        joint = 1e3 * sizing.largest_joint_diameter(length / 1e3, radius / 1e3, tube / 1e3)
+        print(f"{joint:.2f}")
+    if args.plot is not None:
+        mark = (radius / 1e3, joint / 1e3, length / 1e3) if radius and joint and length else None
+        path = sizing.plot_joint_lengths(args.plot, tube / 1e3, mark=mark)
+        print(_paper_summary("figure", path))
+    return 0
 
 
 def _add_out_option(parser: argparse.ArgumentParser) -> None:

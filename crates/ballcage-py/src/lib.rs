@@ -6,6 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use ballcage_core::drillpipe::sizing;
 use ballcage_core::loader::{self, Document, Kind};
 use ballcage_core::scene::{IntegratorKind, whole_multiple as core_whole_multiple};
 use pyo3::create_exception;
@@ -351,6 +352,30 @@ fn whole_multiple(interval: f64, step: f64) -> Option<u64> {
     core_whole_multiple(interval, step)
 }
 
+/// Eq. (9): the longest rigid link [m] that fits the bent tube.
+#[pyfunction]
+fn longest_link(curvature_radius: f64, tube_diameter: f64, link_radius: f64) -> f64 {
+    sizing::longest_link(curvature_radius, tube_diameter, link_radius)
+}
+
+/// Eq. (9) solved for R: the tightest centreline radius [m] a link fits.
+#[pyfunction]
+fn tightest_radius_for_link(length: f64, tube_diameter: f64, link_radius: f64) -> f64 {
+    sizing::tightest_radius_for_link(length, tube_diameter, link_radius)
+}
+
+/// Eq. (9) solved for r: the largest link radius [m] for a length, or `None`.
+#[pyfunction]
+fn largest_link_radius(length: f64, curvature_radius: f64, tube_diameter: f64) -> Option<f64> {
+    sizing::largest_link_radius(length, curvature_radius, tube_diameter)
+}
+
+/// The tightest radius [m] at which hinges of pitch `pitch` bend `bend_limit` [rad].
+#[pyfunction]
+fn tightest_radius_for_bend(pitch: f64, bend_limit: f64) -> f64 {
+    sizing::tightest_radius_for_bend(pitch, bend_limit)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -371,6 +396,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(default_scene_toml, m)?)?;
     m.add_function(wrap_pyfunction!(integrator_facts, m)?)?;
     m.add_function(wrap_pyfunction!(whole_multiple, m)?)?;
+    m.add_function(wrap_pyfunction!(longest_link, m)?)?;
+    m.add_function(wrap_pyfunction!(tightest_radius_for_link, m)?)?;
+    m.add_function(wrap_pyfunction!(largest_link_radius, m)?)?;
+    m.add_function(wrap_pyfunction!(tightest_radius_for_bend, m)?)?;
     m.add(
         "TABLE_NAMES",
         loader::tables().iter().map(|t| t.name).collect::<Vec<_>>(),

@@ -49,7 +49,12 @@ Modules, one job each: `common` (integrators, scene overrides, progress),
 `schemas` (the two table layouts), `accuracy_run` and `accuracy_report`
 (running the work-precision study; its files), `stability_parameters` (what is
 varied), `stability_search` (the stable-step search), `stability_run` and
-`stability_report` (running the stability study; its files).
+`stability_report` (running the stability study; its files); the sweeps
+(``ballcage sweep``, docs/studies.md): `sweep_spec` (the sweep file and its
+cases), `sweep_case` (one case on a worker: run, files, record),
+`sweep_quantities` (a case's derived quantities, by the paper module's
+definitions), `sweep_summary` (``summary.parquet``), `sweep_plots` and
+`sweep_run` (`sweep`: local threads or Dask, resume, progress).
 """
 
 from ballcage.studies.accuracy_report import accuracy_markdown, write_accuracy
@@ -67,6 +72,8 @@ from ballcage.studies.stability_parameters import (
 )
 from ballcage.studies.stability_report import stability_markdown, write_stability
 from ballcage.studies.stability_run import stability
+from ballcage.studies.sweep_run import SweepResult, sweep
+from ballcage.studies.sweep_spec import SweepError, SweepSpec, load_sweep
 
 __all__ = [
     "ACCURACY_SCHEMA",
@@ -77,15 +84,20 @@ __all__ = [
     "Parameter",
     "Quantity",
     "StudyError",
+    "SweepError",
+    "SweepResult",
+    "SweepSpec",
     "accuracy",
     "accuracy_markdown",
     "available_integrators",
+    "load_sweep",
     "default_steps",
     "drill_pipe_parameters",
     "probe_scene",
     "quantities",
     "stability",
     "stability_markdown",
+    "sweep",
     "tightest_radius",
     "write_accuracy",
     "write_stability",

@@ -142,13 +142,19 @@ impl Placement {
             p.link_diameter / 2.0,
         );
         if r < fit {
+            let (d, tube) = (p.link_diameter, spec.borehole.inner_diameter);
+            let longest = super::sizing::longest_link(r, tube, d / 2.0);
             return Err(SceneError::new(
                 "borehole.curvature_radius",
                 r,
                 format!(
-                    "a {} m link of Ø{} m does not fit a Ø{} m tube bent this tightly: \
-                     eq. (9) needs R ≥ {fit:.4} m",
-                    p.pitch, p.link_diameter, spec.borehole.inner_diameter
+                    "a {} m link of Ø{d} m does not fit a Ø{tube} m tube bent this tightly: \
+                     eq. (9) needs R ≥ {fit:.4} m, {:.4} m more; at this R the longest \
+                     link that fits is {longest:.4} m, pipe.pitch is {:.4} m too long \
+                     (`ballcage size`)",
+                    p.pitch,
+                    fit - r,
+                    p.pitch - longest
                 ),
             ));
         }
@@ -168,10 +174,13 @@ impl Placement {
                 "borehole.curvature_radius",
                 r,
                 format!(
-                    "placed on this arc, hinge {h} bends {bend:.2}°, beyond the hinge's \
+                    "placed on this arc, hinge {h} bends {bend:.2}°, {:.2}° beyond the hinge's \
                      articulation limit of {limit:.2}° (where the head's neck, pipe.neck_radius, \
-                     meets the seat's mouth); chains of two or more links need R ≥ {:.4} m",
-                    spec.tightest_radius()
+                     meets the seat's mouth); chains of two or more links need R ≥ {:.4} m, \
+                     {:.4} m more",
+                    bend - limit,
+                    spec.tightest_radius(),
+                    spec.tightest_radius() - r
                 ),
             ));
         }

@@ -16,7 +16,7 @@
 //! | `names` | the one place part names are formatted |
 //! | `layout` | body and pair ids of the parts |
 //! | `tables` | the drill pipe's output tables and their observer |
-//! | `sizing` | eq. (9) and the articulation limit |
+//! | `sizing` | eq. (9) both ways and the articulation limit |
 //! | `chain` | placement along the centreline, eq. (4)/(5) |
 //! | `cv` | exact constant-velocity ball-cage geometry |
 

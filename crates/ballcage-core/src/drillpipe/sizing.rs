@@ -1,5 +1,10 @@
 //! Geometric limits of a drill pipe in a curved tube: the paper's eq. (9)
-//! and the hinge's articulation limit.
+//! both ways (`ballcage size`) and the hinge's articulation limit.
+//!
+//! Eq. (8) is the right triangle of Figure 14, (L/2)² + (R − D/2 + 2r)² =
+//! (R + D/2)²: the link's corners on the tube's outer wall, its inner face
+//! on the inner wall. Eq. (9) is that triangle solved for L; expanded, its
+//! 2RD − 4Rr + 2Dr − 4r² is 2(D − 2r)(R + r), the form used here.
 
 use super::spec::{BallKeySpec, DrillPipeSpec};
 
@@ -19,6 +24,30 @@ pub fn tightest_radius_for_link(length: f64, tube_diameter: f64, link_radius: f6
         return f64::INFINITY;
     }
     (length / 2.0).powi(2) / (2.0 * gap) - link_radius
+}
+
+/// Eq. (9) solved for r: the largest radius [m] of a rigid link of length
+/// `length` that fits a tube of inner diameter `tube_diameter` bent to
+/// centreline radius `curvature_radius` [m]; `None` when even a link of no
+/// radius does not fit, L > 2·√(2RD).
+///
+/// (L/2)² = 2(D − 2r)(R + r) is 2r² + (2R − D)r + L²/8 − RD = 0, whose
+/// larger root is r = (D − 2R + √((2R + D)² − L²)) / 4 (the smaller one is
+/// negative). For R > D/2 the same root is written without the cancellation
+/// of D − 2R against the square root: r = (8RD − L²) / (4(√((2R + D)² − L²) + 2R − D)).
+pub fn largest_link_radius(length: f64, curvature_radius: f64, tube_diameter: f64) -> Option<f64> {
+    let (l, r, d) = (length, curvature_radius, tube_diameter);
+    let room = 8.0 * r * d - l * l;
+    if room < 0.0 {
+        return None;
+    }
+    let root = ((2.0 * r + d).powi(2) - l * l).sqrt();
+    let radius = if 2.0 * r > d {
+        room / (4.0 * (root + 2.0 * r - d))
+    } else {
+        (d - 2.0 * r + root) / 4.0
+    };
+    Some(radius)
 }
 
 /// The tightest radius [m] at which links of pitch `pitch` bend by
@@ -109,6 +138,48 @@ mod tests {
             1.5,
             max_relative = 1e-12
         );
+    }
+
+    #[test]
+    fn eq9_solved_for_the_link_radius() {
+        // R = 1 m, D = 0.1 m, L = √0.41 m: (2R + D)² − L² = 4.41 − 0.41 = 4,
+        // r = (0.1 − 2 + 2) / 4 = 0.025 m; forward, 2·√(2·0.05·1.025) = √0.41.
+        let l = 0.41_f64.sqrt();
+        assert_relative_eq!(longest_link(1.0, 0.1, 0.025), l, max_relative = 1e-14);
+        let r = largest_link_radius(l, 1.0, 0.1).unwrap();
+        assert_relative_eq!(r, 0.025, max_relative = 1e-12);
+        // The paper's pipe: the 608.54 mm link of R = 1.5 m is Ø86 mm.
+        let r = largest_link_radius(longest_link(1.5, 0.116, 0.043), 1.5, 0.116).unwrap();
+        assert_relative_eq!(r, 0.043, max_relative = 1e-12);
+        // A link of no length may be as wide as the bore; one longer than
+        // 2·√(2RD) = 2·√0.2 = 0.89443 m fits at no radius; just below it, a thin one.
+        assert_relative_eq!(
+            largest_link_radius(0.0, 1.0, 0.1).unwrap(),
+            0.05,
+            max_relative = 1e-14
+        );
+        assert_eq!(largest_link_radius(0.9, 1.0, 0.1), None);
+        let thin = largest_link_radius(0.894, 1.0, 0.1).unwrap();
+        assert!(thin > 0.0 && thin < 2e-4, "{thin}");
+        // Below R = D/2 the direct form is used: R = 0.04, D = 0.1, r = 0.01 round-trips.
+        let l = longest_link(0.04, 0.1, 0.01);
+        assert_relative_eq!(
+            largest_link_radius(l, 0.04, 0.1).unwrap(),
+            0.01,
+            max_relative = 1e-12
+        );
+        // Round trips over a range of radii, to 1e-12 relative.
+        for k in 1..=20 {
+            let (big_r, small_r) = (0.2 * f64::from(k), 0.002 * f64::from(k));
+            let l = longest_link(big_r, 0.116, small_r);
+            let back = largest_link_radius(l, big_r, 0.116).unwrap();
+            assert_relative_eq!(back, small_r, max_relative = 1e-12);
+            assert_relative_eq!(
+                tightest_radius_for_link(l, 0.116, small_r),
+                big_r,
+                max_relative = 1e-12
+            );
+        }
     }
 
     #[test]

@@ -1,0 +1,178 @@
+"""One sweep case where it runs (a local thread or a Dask worker): run, write its files, write its record.
+
+`run_case` is the only function a worker executes. It writes straight into
+the sweep's output folder (on Dask, a filesystem every worker and the client
+share): ``DIR/<table>/case=NNNN/part.parquet`` for each recorded table, then
+``DIR/cases/case=NNNN.scene.toml`` and, last, the case's record
+``DIR/cases/case=NNNN.json`` (`CaseRecord` fields: status, error, swept
+values, engine cost, derived quantities). Every file is written to a
+temporary name and renamed, so a file under its final name is complete, and a
+case with a record is finished. A run that diverges keeps what it recorded up
+to then (status ``diverged``); any other failure is status ``error``; neither
+is raised.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ballcage import _native
+from ballcage._files import write_parquet, write_text
+from ballcage.run import Run, simulate
+from ballcage.studies.sweep_quantities import case_quantities
+
+__all__ = ["CaseTask", "read_record", "record_path", "run_case", "write_record"]
+
+#: Name of every table file inside a case's partition directory.
+PART = "part.parquet"
+#: Folder of the per-case records and scenes.
+CASES = "cases"
+
+
+@dataclass(frozen=True)
+class CaseTask:
+    """Everything a worker needs for one case (plain data: it is pickled to Dask workers)."""
+
+    index: int
+    case_id: str
+    digest: str
+    partition: str  # "case=0003"
+    base_toml: str
+    overrides: tuple[str, ...]
+    values: dict[str, Any]  # swept key -> value as written
+    parameters: tuple[str, ...]  # every swept key of the sweep, for the resolved values
+    out: str  # the sweep's output folder
+
+
+def record_path(out: Path, partition: str) -> Path:
+    """Where the record of the case in `partition` lives: ``DIR/cases/case=NNNN.json``."""
+    return out / CASES / f"{partition}.json"
+
+
+def table_path(out: Path, table: str, partition: str) -> Path:
+    return out / table / partition / PART
+
+
+def run_case(task: CaseTask) -> dict[str, Any]:
+    """Runs one case, writes its tables, scene and record into ``task.out``; returns the record (a dict)."""
+    start = time.perf_counter()
+    out = Path(task.out)
+    scene = _native.Scene.from_toml(task.base_toml, list(task.overrides))
+    run: Run | None = None
+    status, error = "ok", None
+    try:
+        run = simulate(scene, progress=False)
+    except _native.SimulationError as e:
+        run, status, error = getattr(e, "run", None), "diverged", str(e)
+    except Exception as e:  # noqa: BLE001 - a failing case is recorded, never raised
+        status, error = "error", _describe(e)
+    record = _base_record(task, scene, status, error)
+    try:
+        if run is not None:
+            record["tables"] = _write_tables(run, out, task.partition)
+            record.update(_cost(run))
+            record["quantities"] = case_quantities(run)
+    except Exception as e:  # noqa: BLE001
+        record["status"], record["error"] = "error", _join(error, f"after the run: {_describe(e)}")
+    write_text(scene.to_toml(units=True) if scene.kind == "drill-pipe" else scene.to_toml(), _scene_path(out, task))
+    record["case_wall_time_s"] = time.perf_counter() - start
+    write_record(out, record)
+    return record
+
+
+def failed_record(task: CaseTask, error: BaseException) -> dict[str, Any]:
+    """The record of a case whose worker failed before writing one (e.g. a lost Dask worker)."""
+    scene = _native.Scene.from_toml(task.base_toml, list(task.overrides))
+    return _base_record(task, scene, "error", f"worker: {_describe(error)}")
+
+
+def _base_record(task: CaseTask, scene: _native.Scene, status: str, error: str | None) -> dict[str, Any]:
+    return {
+        "case": task.index,
+        "case_id": task.case_id,
+        "digest": task.digest,
+        "partition": task.partition,
+        "overrides": list(task.overrides),
+        "values": task.values,
+        "parameters": {k: scene.value(k) for k in task.parameters},
+        "status": status,
+        "error": error,
+        "tables": [],
+        "quantities": {},
+    }
+
+
+def _write_tables(run: Run, out: Path, partition: str) -> list[str]:
+    names = []
+    for name, table in run.tables.items():
+        path = table_path(out, name, partition)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_parquet(table, path)
+        names.append(name)
+    return names
+
+
+def _cost(run: Run) -> dict[str, Any]:
+    meta = run.metadata
+
+    def number(key: str) -> float | None:
+        try:
+            return float(meta[key])
+        except (KeyError, ValueError):
+            return None
+
+    steps, dt = number("ballcage.steps"), number("ballcage.dt_s")
+    return {
+        "wall_time_s": number("ballcage.wall_time_s"),
+        "steps": int(steps) if steps is not None else None,
+        "simulated_time_s": steps * dt if steps is not None and dt is not None else None,
+    }
+
+
+def _scene_path(out: Path, task: CaseTask) -> Path:
+    path = out / CASES / f"{task.partition}.scene.toml"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def write_record(out: Path, record: dict[str, Any]) -> Path:
+    """Writes a case record (JSON, NaN and infinities as null) atomically; it marks the case finished."""
+    path = record_path(out, record["partition"])
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return write_text(json.dumps(_clean(record), indent=1, sort_keys=True, allow_nan=False) + "\n", path)
+
+
+def read_record(out: Path, partition: str) -> dict[str, Any] | None:
+    """The record of a finished case; ``None`` when there is none (or it cannot be read)."""
+    try:
+        data = json.loads(record_path(out, partition).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _clean(value: Any) -> Any:
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {str(k): _clean(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_clean(v) for v in value]
+    return value
+
+
+def _describe(error: BaseException) -> str:
+    text = str(error) or type(error).__name__
+    frames = traceback.extract_tb(error.__traceback__)
+    where = f" (at {Path(frames[-1].filename).name}:{frames[-1].lineno})" if frames else ""
+    return f"{type(error).__name__}: {text}{where}"
+
+
+def _join(first: str | None, second: str) -> str:
+    return f"{first}; {second}" if first else second

@@ -1,0 +1,304 @@
+"""Running a sweep: `sweep(spec, out)` locally in threads, or on a Dask cluster with ``client=``.
+
+Output folder (docs/studies.md)::
+
+    DIR/summary.parquet                      one row per case (`summary_table`)
+    DIR/<table>/case=NNNN/part.parquet       one hive-partitioned dataset per table kind
+    DIR/cases/case=NNNN.json                 the case's record: written last, it marks the case finished
+    DIR/cases/case=NNNN.scene.toml           the case's resolved scene
+    DIR/plots/<parameter>.png                each quantity against each swept parameter
+
+Running the same sweep into the same folder again resumes: a case with a
+record whose hash matches and whose table files exist is skipped (with
+``retry_failed``, only if it finished ``ok``). A record of another sweep's
+case (another hash) is refused, naming the case.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+import pyarrow as pa
+
+from ballcage._files import write_parquet
+from ballcage.run import _isatty
+from ballcage.studies.sweep_case import CaseTask, failed_record, read_record, run_case, table_path, write_record
+from ballcage.studies.sweep_plots import write_plots
+from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
+from ballcage.studies.sweep_summary import parameter_units, summary_table
+
+__all__ = ["SweepResult", "sweep"]
+
+
+@dataclass
+class SweepResult:
+    """What `sweep` did: the summary table, the folder, and how many cases ran, were skipped and failed."""
+
+    summary: pa.Table
+    out: Path
+    ran: int
+    skipped: int
+    failed: int
+    paths: dict[str, Path] = field(default_factory=dict)
+
+
+def sweep(
+    spec: SweepSource,
+    out: str | os.PathLike[str],
+    *,
+    client: Any = None,
+    workers: int | None = None,
+    retry_failed: bool = False,
+    plots: bool = True,
+    progress: bool | None = None,
+) -> SweepResult:
+    """Runs every case of a sweep file (path, dict or `SweepSpec`) into the folder `out`.
+
+    Locally, `workers` threads (default ``os.cpu_count()``) run the cases; the
+    engine releases the GIL while it integrates. With a
+    ``dask.distributed.Client`` as `client`, the cases run as tasks on its
+    cluster; the workers write into `out` themselves, so it must be a path
+    every worker and this process see (a shared filesystem). A case that
+    diverges or fails is recorded (``status``, ``error``, its partial tables)
+    and the others go on. `progress`: ``None`` a bar on a terminal and a line
+    per case otherwise, ``False`` silent. Raises `SweepError` for a bad sweep
+    file or a folder holding another sweep, before anything runs.
+    """
+    loaded = load_sweep(spec)
+    cases = loaded.check()
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise SweepError(f"--out {folder}: exists and is not a directory")
+    tasks = [_task(loaded, c, folder) for c in cases]
+    pending, done = _split_finished(tasks, folder, retry_failed)
+    say = _Say(progress is not False)
+    where = _where(client, workers)
+    say(f"sweep {loaded.name}: {len(tasks)} cases; {len(done)} already finished in {folder} (skipped), "
+        f"running {len(pending)} {where}")
+    folder.mkdir(parents=True, exist_ok=True)
+    bar = SweepProgress(len(pending), enabled=progress is not False)
+    try:
+        records = done + (_run_dask(client, pending, bar) if client is not None else _run_local(pending, workers, bar))
+    finally:
+        bar.close()
+    return _finish(loaded, records, folder, len(pending), len(done), plots)
+
+
+def _task(spec: SweepSpec, case: Case, out: Path) -> CaseTask:
+    return CaseTask(
+        index=case.index,
+        case_id=case.case_id,
+        digest=case.digest,
+        partition=case.partition,
+        base_toml=spec.base_toml,
+        overrides=case.overrides,
+        values=case.values,
+        parameters=tuple(spec.parameters),
+        out=str(out.resolve()),
+    )
+
+
+def _split_finished(tasks: list[CaseTask], out: Path, retry_failed: bool) -> tuple[list[CaseTask], list[dict[str, Any]]]:
+    """The cases still to run, and the records of those finished (their files all present)."""
+    pending, done = [], []
+    for task in tasks:
+        record = read_record(out, task.partition)
+        if record is None:
+            pending.append(task)
+            continue
+        if record.get("digest") != task.digest:
+            raise SweepError(
+                f"--out {out}: holds case {task.index} of another sweep (case_id {record.get('case_id')}, "
+                f"this sweep's is {task.case_id}): choose another --out folder or remove that one"
+            )
+        files = all(table_path(out, t, task.partition).is_file() for t in record.get("tables", []))
+        if not files or (retry_failed and record.get("status") != "ok"):
+            pending.append(task)
+        else:
+            done.append(record)
+    return pending, done
+
+
+def _where(client: Any, workers: int | None) -> str:
+    if client is not None:
+        return f"on the Dask cluster at {getattr(client.scheduler, 'address', client)}"
+    return f"in {workers or os.cpu_count() or 1} local threads"
+
+
+def _run_local(tasks: list[CaseTask], workers: int | None, bar: SweepProgress) -> list[dict[str, Any]]:
+    if not tasks:
+        return []
+    count = max(1, min(workers or os.cpu_count() or 1, len(tasks)))
+    executor = ThreadPoolExecutor(max_workers=count, thread_name_prefix="ballcage-sweep")
+    try:
+        futures = {executor.submit(run_case, t): t for t in tasks}
+        records = []
+        for future in as_completed(futures):
+            records.append(_result(future.result, futures[future]))
+            bar.update(records[-1])
+        return records
+    except KeyboardInterrupt:
+        executor.shutdown(wait=False, cancel_futures=True)
+        raise
+    finally:
+        executor.shutdown(wait=True)
+
+
+def _run_dask(client: Any, tasks: list[CaseTask], bar: SweepProgress) -> list[dict[str, Any]]:
+    from distributed import as_completed as dask_completed  # the optional extra: ballcage[dask]
+
+    if not tasks:
+        return []
+    futures = {client.submit(run_case, t, pure=False): t for t in tasks}
+    records = []
+    try:
+        for future in dask_completed(list(futures)):
+            records.append(_result(future.result, futures[future]))
+            bar.update(records[-1])
+    except KeyboardInterrupt:
+        client.cancel(list(futures))
+        raise
+    return records
+
+
+def _result(get: Callable[[], dict[str, Any]], task: CaseTask) -> dict[str, Any]:
+    """The case's record; when the worker itself failed (not the case), a record saying so, written here."""
+    try:
+        return get()
+    except Exception as e:  # noqa: BLE001 - e.g. a worker lost; the sweep goes on
+        record = failed_record(task, e)
+        write_record(Path(task.out), record)
+        return record
+
+
+def _finish(spec: SweepSpec, records: list[dict[str, Any]], out: Path, ran: int, skipped: int, plots: bool) -> SweepResult:
+    from ballcage import _native
+
+    units = parameter_units(_native.Scene.from_toml(spec.base_toml).to_toml(units=True), spec.parameters)
+    meta = {
+        "ballcage.sweep": spec.name,
+        "ballcage.sweep_parameters": json.dumps(spec.parameters),
+        "ballcage.sweep_fixed": json.dumps(spec.fixed),
+        "ballcage.sweep_base": str(spec.base) if spec.base is not None else "embedded paper scene",
+    }
+    table = summary_table(records, spec.parameters, units, meta)
+    paths = {"summary": write_parquet(table, out / "summary.parquet")}
+    if plots:
+        paths.update({f"plot_{k}": v for k, v in write_plots(table, spec.parameters, out).items()})
+    failed = sum(1 for r in records if r.get("status") != "ok")
+    return SweepResult(table, out, ran, skipped, failed, paths)
+
+
+class SweepProgress:
+    """Counts finished cases on stderr with an estimate of the time left.
+
+    On a terminal it redraws one line (a bar); otherwise it prints one line per case.
+    """
+
+    WIDTH = 24
+
+    def __init__(self, total: int, *, enabled: bool, stream: TextIO | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        self.total, self.enabled = total, enabled and total > 0
+        self.stream = stream if stream is not None else sys.stderr
+        self.clock, self.start = clock, clock()
+        self.done = self.failed = 0
+        self.tty = _isatty(self.stream)
+
+    def update(self, record: dict[str, Any]) -> None:
+        self.done += 1
+        self.failed += record.get("status") != "ok"
+        if not self.enabled:
+            return
+        elapsed = self.clock() - self.start
+        left = elapsed / self.done * (self.total - self.done)
+        counts = f"{self.done}/{self.total} cases" + (f", {self.failed} failed" if self.failed else "")
+        timing = f"{elapsed:.1f} s, ~{left:.0f} s left" if self.done < self.total else f"{elapsed:.1f} s"
+        case = f"case {record.get('case_id')} {record.get('status')}"
+        if self.tty:
+            if record.get("status") != "ok":
+                self.stream.write("\r\x1b[K" + f"ballcage: {case}: {record.get('error')}\n")
+            filled = round(self.WIDTH * self.done / self.total)
+            self.stream.write("\r\x1b[K" + f"ballcage: [{'#' * filled}{'.' * (self.WIDTH - filled)}] {counts}  {timing}")
+        else:
+            error = f": {record.get('error')}" if record.get("error") else ""
+            self.stream.write(f"ballcage: {counts} ({case}{error})  {timing}\n")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled and self.tty and self.done:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+class _Say:
+    def __init__(self, enabled: bool) -> None:
+        self.enabled = enabled
+
+    def __call__(self, text: str) -> None:
+        if self.enabled:
+            print(f"ballcage: {text}", file=sys.stderr, flush=True)
+
+
+def describe(result: SweepResult) -> Iterable[str]:
+    """Lines the CLI prints after a sweep."""
+    yield f"wrote {result.paths['summary']}  ({result.summary.num_rows} cases)"
+    for name, path in result.paths.items():
+        if name.startswith("plot_"):
+            yield f"wrote {path}  (plot)"
+    yield (
+        f"ballcage: {result.ran} cases run, {result.skipped} skipped (already finished), "
+        f"{result.failed} of {result.summary.num_rows} not ok"
+    )
+
+
+def command(args: Any) -> int:
+    """``ballcage sweep``: runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not."""
+    client = None
+    if args.scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise SweepError("--scheduler needs dask.distributed: pip install 'ballcage[dask]'") from None
+        try:
+            client = Client(args.scheduler, timeout="20s")
+        except (OSError, TimeoutError) as e:
+            raise SweepError(f"--scheduler {args.scheduler}: cannot connect: {e}") from None
+    try:
+        result = sweep(
+            args.sweep,
+            args.out,
+            client=client,
+            workers=args.workers,
+            retry_failed=args.retry_failed,
+            plots=not args.no_plots,
+            progress=False if args.quiet else None,
+        )
+    except KeyboardInterrupt:
+        print(f"ballcage: sweep interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
+        raise
+    finally:
+        if client is not None:
+            client.close()
+    if not args.quiet:
+        for line in describe(result):
+            print(line)
+    if result.failed:
+        bad = [r for r in result.summary.to_pylist() if r["status"] != "ok"]
+        first = bad[0]
+        print(
+            f"ballcage: error: {result.failed} of {result.summary.num_rows} cases did not finish "
+            f"(case {first['case_id']} {first['status']}: {' '.join(str(first['error']).split())}); "
+            f"see {result.paths['summary']}",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
