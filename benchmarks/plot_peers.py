@@ -5,7 +5,7 @@ Reads what the two peer comparisons wrote and draws, in docs/performance.md's te
 - error of the per-link mean tube forces against ballcage's converged reference
   (the L2 norm of the differences over the L2 norm of the reference) against the
   wall time of the stepping loop, one marker per engine and step;
-- wall time of the stepping loop against the number of joints.
+- wall time of the stepping loop against the number of joints, and against the simulated time.
 
 Inputs:
 
@@ -43,7 +43,8 @@ def read_rapier(path: Path) -> dict:
         if m := WALL.match(line):
             out["wall"][m.group(1)] = float(m.group(2))
         elif m := HEAD.match(line):
-            out["dt"], out["window"] = float(m.group(1)), (float(m.group(3)), float(m.group(4)))
+            out["dt"], out["duration"] = float(m.group(1)), float(m.group(2))
+            out["window"] = (float(m.group(3)), float(m.group(4)))
         elif m := JOINTS.match(line):
             out["joints"] = int(m.group(1))
         elif m := ROW.match(line):
@@ -110,28 +111,30 @@ def plot_work_precision(points: list[tuple], out: Path) -> None:
     print(f"wrote {out}")
 
 
-def plot_scaling(scaling: list[dict], rapier: list[dict], out: Path) -> None:
+def plot_scaling(scaling: list[dict], rapier: list[dict], out: Path, along: str = "joints") -> None:
+    """Wall time of each engine's stepping loop against `along`: ``"joints"`` or ``"duration"`` [s]."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    series: dict[str, list[tuple[int, float]]] = {}
+    series: dict[str, list[tuple[float, float]]] = {}
     for doc in scaling:
         for r in doc["results"]:
             if r["engine"] != "ballcage-ref" and r.get("complete"):
-                series.setdefault(r["engine"], []).append((r["joints"], r["wall_s"]))
+                series.setdefault(r["engine"], []).append((r[along], r["wall_s"]))
     for r in rapier:
-        series.setdefault("rapier", []).append((r["joints"], r["wall"]["rapier"]))
+        series.setdefault("rapier", []).append((r[along], r["wall"]["rapier"]))
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     for engine, pts in sorted(series.items()):
         pts.sort()
         ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=engine)
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
-    ax.set_xlabel("joints [-]")
+    ax.set_xlabel("joints [-]" if along == "joints" else "simulated time [s]")
     ax.set_ylabel("wall time of the stepping loop [s]")
-    ax.set_title("ideal-CV chain at 1 ms: run time against the number of joints")
+    what = "the number of joints" if along == "joints" else "the simulated time, 12 joints"
+    ax.set_title(f"ideal-CV chain at 1 ms: run time against {what}")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
@@ -145,6 +148,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--rapier", nargs="*", type=Path, default=[], help="rapier_forces outputs, same window")
     p.add_argument("--scaling", nargs="*", type=Path, default=[], help="peers.py JSON of a --joints scan")
     p.add_argument("--rapier-scaling", nargs="*", type=Path, default=[], help="rapier_forces outputs per joints")
+    p.add_argument("--durations", nargs="*", type=Path, default=[], help="peers.py JSON of a --duration scan")
+    p.add_argument("--rapier-durations", nargs="*", type=Path, default=[], help="rapier_forces outputs per duration")
     p.add_argument("--out", type=Path, default=Path("."), help="directory for the PNGs")
     a = p.parse_args(argv)
     peers = [json.loads(f.read_text()) for f in a.peers]
@@ -157,6 +162,10 @@ def main(argv: list[str] | None = None) -> int:
     if a.scaling or a.rapier_scaling:
         scaling = [json.loads(f.read_text()) for f in a.scaling]
         plot_scaling(scaling, [read_rapier(f) for f in a.rapier_scaling], a.out / "scaling-peers.png")
+    if a.durations or a.rapier_durations:
+        durations = [json.loads(f.read_text()) for f in a.durations]
+        rapier = [read_rapier(f) for f in a.rapier_durations]
+        plot_scaling(durations, rapier, a.out / "duration-peers.png", along="duration")
     return 0
 
 
