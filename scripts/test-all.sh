@@ -14,6 +14,13 @@ echo "== cargo test"
 cargo test --workspace
 echo "== pip install .[test] (release build of the wheel)"
 python3 -m pip install --quiet ".[test]"
+echo "== the test-panic build (tests/test_panic.py; never shipped)"
+# The extension with cargo feature `test-panic` (a panic injected into Simulation.advance), installed into a
+# side directory that tests/test_panic.py puts first on PYTHONPATH of its subprocesses.
+rm -rf target/wheels-test-panic target/ballcage-test-panic
+maturin build --quiet --release --features test-panic -o target/wheels-test-panic
+python3 -m pip install --quiet --no-deps --target target/ballcage-test-panic target/wheels-test-panic/*.whl
+export BALLCAGE_TEST_PANIC_PATH="$PWD/target/ballcage-test-panic"
 echo "== stubtest (python/ballcage/_native.pyi against the built module)"
 python3 -m mypy.stubtest ballcage._native --mypy-config-file pyproject.toml
 echo "== pytest"

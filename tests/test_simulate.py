@@ -175,12 +175,16 @@ def test_debug_build_warns_on_import():
 
 def test_public_api_is_curated():
     assert set(ballcage.__all__) == {
-        "DrillPipeBuilder", "Run", "Scene", "SceneBuilder", "SceneError", "Simulation", "SimulationError",
-        "__version__", "buckling", "largest_joint_diameter", "load_scene", "longest_joint", "simulate",
-        "smallest_curvature_radius", "table_schema",
+        "DrillPipeBuilder", "Error", "InputError", "InternalError", "Run", "Scene", "SceneBuilder", "SceneError",
+        "Simulation", "SimulationError", "__version__", "buckling", "largest_joint_diameter", "load_scene",
+        "longest_joint", "simulate", "smallest_curvature_radius", "table_schema",
     }
-    assert issubclass(ballcage.SceneError, ValueError)
-    assert issubclass(ballcage.SimulationError, RuntimeError)
+    # one base class for every error, each also the built-in exception code written before it catches
+    assert issubclass(ballcage.SceneError, ballcage.Error) and issubclass(ballcage.SceneError, ValueError)
+    assert issubclass(ballcage.SimulationError, ballcage.Error) and issubclass(ballcage.SimulationError, RuntimeError)
+    assert issubclass(ballcage.InputError, ballcage.Error) and issubclass(ballcage.InputError, ValueError)
+    assert issubclass(ballcage.InternalError, ballcage.Error) and issubclass(ballcage.InternalError, RuntimeError)
+    assert not issubclass(ballcage.SceneError, ballcage.SimulationError)
     assert isinstance(ballcage.__version__, str) and ballcage.__version__
 
 

@@ -10,6 +10,10 @@ The pipeline is scene → simulation → tables::
 
 A scene is a TOML file, a dict of the same structure, or a `SceneBuilder`;
 `load_scene` validates it (in Rust) and raises `SceneError` naming the field.
+Every error ballcage raises is a `ballcage.Error`: `SceneError` (a scene field),
+`SimulationError` (a run that diverged), `InputError` (a function argument),
+`InternalError` (a bug: a Rust panic, caught), and the studies' `StudyError`
+and `SweepError`.
 All quantities are SI; units are in each output column's field metadata.
 
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
@@ -26,7 +30,16 @@ import warnings as _warnings
 from typing import Any as _Any
 
 from ballcage import _native
-from ballcage._native import Scene, SceneError, Simulation, SimulationError, table_schema
+from ballcage._native import (
+    Error,
+    InputError,
+    InternalError,
+    Scene,
+    SceneError,
+    Simulation,
+    SimulationError,
+    table_schema,
+)
 from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
@@ -36,6 +49,9 @@ __version__: str = _native.__version__
 
 __all__ = [
     "DrillPipeBuilder",
+    "Error",
+    "InputError",
+    "InternalError",
     "Run",
     "Scene",
     "SceneBuilder",

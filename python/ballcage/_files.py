@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import os
 import secrets
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,7 +12,7 @@ if TYPE_CHECKING:
     import pyarrow as pa
     from matplotlib.figure import Figure
 
-__all__ = ["write_atomically", "write_parquet", "write_png", "write_text"]
+__all__ = ["write_all_atomically", "write_atomically", "write_parquet", "write_png", "write_text"]
 
 
 def write_atomically(final: Path, write: Callable[[Path], object]) -> None:
@@ -20,12 +20,57 @@ def write_atomically(final: Path, write: Callable[[Path], object]) -> None:
 
     `write(tmp)` fills the temporary file; it is then fsynced and renamed over
     `final` (``os.replace``, atomic on POSIX and Windows). On any exception the
-    temporary file is removed and `final` is left as it was.
+    temporary file is removed and `final` is left as it was. The temporary is
+    ``.<name>.<8 hex digits>.tmp``: a process killed mid-write (SIGKILL, power
+    loss) may leave it behind, hidden and never under a final name (pyarrow's
+    dataset discovery skips names starting with a dot). A failed write raises
+    `OSError` naming `final` and the reason (e.g. ``[Errno 28] No space left on
+    device: '<final>'``), not the temporary's name.
     """
+    write_all_atomically({final: write})
+
+
+def write_all_atomically(files: Mapping[Path, Callable[[Path], object]]) -> None:
+    """Writes several files so that a failure changes none of them: every temporary first, then the renames.
+
+    Each ``write(tmp)`` of `files` (final path -> writer) fills its own hidden
+    temporary (as `write_atomically`), which is fsynced; only when all are
+    written are they renamed over their final names, one after the other. A
+    write that fails (a full disk, Ctrl-C) removes every temporary and leaves
+    each final file as it was, so an output folder never mixes two runs'
+    files; only a process killed within the renames themselves (microseconds)
+    can leave some renamed and not others.
+    """
+    temporaries: list[tuple[Path, Path]] = []
+    try:
+        for final, write in files.items():
+            tmp = _create_temporary(final)
+            temporaries.append((tmp, final))
+            _fill(tmp, final, write)
+        for tmp, final in temporaries:
+            os.replace(tmp, final)
+    except BaseException:
+        for tmp, _ in temporaries:
+            tmp.unlink(missing_ok=True)
+        raise
+    for directory in dict.fromkeys(final.parent for final in files):
+        _fsync_directory(directory)
+
+
+def _create_temporary(final: Path) -> Path:
+    """Creates the empty hidden temporary ``.<name>.<8 hex digits>.tmp`` beside `final`; returns its path."""
     tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
-    # O_EXCL: never clobber another writer's temporary; mode 0o666 minus umask,
-    # the permissions a plain open() would give the final file.
-    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    try:
+        # O_EXCL: never clobber another writer's temporary; mode 0o666 minus umask,
+        # the permissions a plain open() would give the final file.
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+    except OSError as e:
+        raise _naming(e, tmp, final) or e
+    return tmp
+
+
+def _fill(tmp: Path, final: Path, write: Callable[[Path], object]) -> None:
+    """Runs ``write(tmp)`` and fsyncs `tmp`; an `OSError` is raised naming `final` (see `_naming`)."""
     try:
         write(tmp)
         fd = os.open(tmp, os.O_RDONLY)
@@ -33,11 +78,23 @@ def write_atomically(final: Path, write: Callable[[Path], object]) -> None:
             os.fsync(fd)
         finally:
             os.close(fd)
-        os.replace(tmp, final)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    _fsync_directory(final.parent)
+    except OSError as e:
+        raise _naming(e, tmp, final) or e
+
+
+def _naming(error: OSError, tmp: Path, final: Path) -> OSError | None:
+    """`error`'s errno naming `final` instead of `tmp` (or of no file); ``None`` when `error` names another file.
+
+    pyarrow's messages ("Error writing bytes to file. Detail: [errno 28] ...")
+    name no file; the errno's own text ("No space left on device") is the reason a reader needs.
+    The result's ``__cause__`` is `error`.
+    """
+    if error.filename is not None and os.fspath(error.filename) != os.fspath(tmp):
+        return None
+    reason = os.strerror(error.errno) if error.errno else (error.strerror or str(error))
+    named = OSError(error.errno, reason, str(final))
+    named.__cause__ = error
+    return named
 
 
 def write_parquet(table: pa.Table, path: Path) -> Path:

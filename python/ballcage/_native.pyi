@@ -14,8 +14,11 @@ __all__ = [
     "TABLE_NAMES",
     "INTEGRATORS",
     "SCENE_KINDS",
+    "Error",
     "SceneError",
     "SimulationError",
+    "InputError",
+    "InternalError",
     "Scene",
     "Simulation",
     "default_scene_toml",
@@ -40,7 +43,10 @@ INTEGRATORS: list[str]
 #: Every scene kind (the `kind` key of a scene document).
 SCENE_KINDS: list[str]
 
-class SceneError(ValueError):
+class Error(Exception):
+    """Base class of every error ballcage raises: ``except ballcage.Error`` catches them all."""
+
+class SceneError(Error, ValueError):
     """A scene that cannot be read or validated.
 
     ``str(e)`` reads ``scene field `bodies[1].mass` = -2: must be positive``;
@@ -54,9 +60,18 @@ class SceneError(ValueError):
     value: str
     #: Why the value is rejected.
     reason: str
+    #: Every error found in the same pass as ``(path, value, reason)``, the first being the one above;
+    #: ``str(e)`` lists them all, separated by ``"; "``.
+    errors: list[tuple[str, str, str]]
 
-class SimulationError(RuntimeError):
+class SimulationError(Error, RuntimeError):
     """A run that had to stop because the state stopped being physical."""
+
+class InputError(Error, ValueError, TypeError):
+    """An argument of a ballcage function that is out of range or of the wrong type; the message names it."""
+
+class InternalError(Error, RuntimeError):
+    """A bug in ballcage: a Rust panic, caught and reported with where it happened."""
 
 @final
 class Scene:
@@ -166,7 +181,9 @@ class Simulation:
     def advance(self, t_end: float) -> None:
         """Steps (without the GIL) until `time` >= `t_end`, clamped to `duration`.
 
-        Raises `SimulationError`.
+        Raises `SimulationError` when the run diverges, `InputError` for a
+        non-finite `t_end` or a finished simulation, and `InternalError` for a
+        bug (a Rust panic), after which the simulation is dropped.
         """
 
     def finish(self) -> dict[str, pa.Table]:
@@ -175,7 +192,7 @@ class Simulation:
 def table_schema(name: _TableName | str) -> pa.Schema:
     """The Arrow schema of an output table; each field carries ``unit`` and ``description`` metadata.
 
-    Raises `ValueError` for a name not in `TABLE_NAMES`.
+    Raises `InputError` for a name not in `TABLE_NAMES`.
     """
 
 def integrator_facts() -> dict[str, dict[str, Any]]:

@@ -35,6 +35,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene, load_scene
 
 if TYPE_CHECKING:
@@ -103,7 +104,7 @@ def end_wall_force(torque: float, bends: Sequence[float], pitch: float) -> list[
     and hinge `pitch` l [m] (docs/buckling.md §2, eq. 2.4); the sign is the side it pushes toward.
     """
     if not pitch > 0.0:
-        raise ValueError(f"pitch = {pitch} m: must be positive (the hinge-to-hinge length)")
+        raise InputError(f"pitch = {pitch} m: must be positive (the hinge-to-hinge length)")
     half = [math.tan(b / 2.0) for b in bends]
     return [torque * (half[k + 1] - half[k - 1]) / pitch for k in range(1, len(bends) - 1)]
 
@@ -130,7 +131,7 @@ def buckling(
     patches = list(overrides)
     s = default_scene(patches) if scene is None else load_scene(scene, patches)
     if s.kind != "drill-pipe":
-        raise ValueError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
+        raise InputError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
     pitch, n = float(s.value("pipe.pitch")), int(s.value("pipe.joints"))
     placed = s.placed_chain()
     # Link 1's mass as built (the ideal-CV links carry their hinges' cage and keys).
@@ -194,7 +195,7 @@ def simulate_check(
     from ballcage.run import simulate  # deferred: pyarrow is only needed here
 
     if not 0.0 < window < duration or not 0.0 <= ramp < duration - window:
-        raise ValueError(
+        raise InputError(
             f"duration = {duration} s, ramp = {ramp} s, window = {window} s: "
             "need 0 < window and ramp + window < duration, so the window sees the full torque"
         )
@@ -242,9 +243,9 @@ def _check_terms(friction_moment: float, bending_stiffness: float, axial_tension
     resistances = (("friction_moment", friction_moment, "N·m"), ("bending_stiffness", bending_stiffness, "N·m/rad"))
     for name, value, unit in resistances:
         if not (math.isfinite(value) and value >= 0.0):
-            raise ValueError(f"{name} = {value} {unit}: must be a finite number ≥ 0 (a resistance, not a drive)")
+            raise InputError(f"{name} = {value} {unit}: must be a finite number ≥ 0 (a resistance, not a drive)")
     if not math.isfinite(axial_tension):
-        raise ValueError(f"axial_tension = {axial_tension} N: must be finite (tension positive, compression negative)")
+        raise InputError(f"axial_tension = {axial_tension} N: must be finite (tension positive, compression negative)")
 
 
 def _hinge_drive(

@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import shlex
 import sys
 from collections.abc import Sequence
@@ -55,6 +56,10 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{PROG}: error: {message} (see `{self.prog} --help`)\n")
 
 
+#: Exit code of an internal error (a bug in ballcage): sysexits' EX_SOFTWARE.
+EXIT_INTERNAL = 70
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``ballcage`` script; returns the exit code."""
     given = list(sys.argv[1:] if argv is None else argv)
@@ -66,10 +71,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _fail(str(e), 2)
     except _native.SimulationError as e:
         return _fail(str(e), 1)
+    except _native.InputError as e:  # an option value the API refused (e.g. a sizing length)
+        return _fail(str(e), 2)
+    except _native.InternalError as e:  # a bug: a Rust panic, caught in the glue
+        return _fail(str(e), EXIT_INTERNAL)
     except _study_error() as e:
         return _fail(str(e), 1)
     except OSError as e:
-        return _fail(f"cannot write output: {e}", 3)
+        return _fail(_write_error(e), 3)
     except KeyboardInterrupt:
         return _fail("interrupted", 130)
 
@@ -111,6 +120,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_buckling_command(commands)
     _add_size_command(commands)
     _add_sweep_command(commands)
+    _add_chart_command(commands)
     return parser
 
 
@@ -169,7 +179,13 @@ def _add_paper_command(commands: _Commands) -> None:
     paper.add_argument(
         "--sweeps",
         action="store_true",
-        help="also run the R = 1.0 / 2.5 m and 60 / 120 rpm variants (4 more runs) and fill the sweep rows",
+        help="also run the paper's section 4 as a sweep into DIR/sweeps (R = 1.0-2.5 m at 100 rpm, 60-120 rpm at "
+        "1.5 m, and the baseline with R +-1 um for the run-to-run spread: 9 runs, resumed when run again); fill the "
+        "sweep rows, draw Figures 16-17 and check the paper's trends (trends.parquet)",
+    )
+    paper.add_argument("--workers", metavar="N", type=_workers, help="with --sweeps: local threads (default: one per CPU)")
+    paper.add_argument(
+        "--scheduler", metavar="ADDRESS", help="with --sweeps: run the sweep on the Dask cluster at ADDRESS; needs ballcage[dask]"
     )
     _add_quiet_option(paper, "no progress bar and no summary")
     paper.set_defaults(command=_paper)
@@ -333,6 +349,73 @@ def _sweep(args: argparse.Namespace) -> int:
 
     try:
         return command(args)
+    except SweepError as e:
+        raise UsageError(str(e)) from e
+
+
+def _add_chart_command(commands: _Commands) -> None:
+    chart = commands.add_parser(
+        "chart",
+        help="design chart: key and tube forces over curvature radius x joint length, infeasible cells marked",
+        description=(
+            "For one tube ID and joint OD, check every cell of curvature radius x joint length (pipe.pitch) against "
+            "the paper's eq. (9) and the hinge's articulation limit before running, run the feasible cells as one sweep "
+            "(locally or on Dask; running it again resumes), and write DIR/design_chart.png (heat maps of the peak key "
+            "force and the mean and peak tube forces, excluded cells hatched with the constraint that excludes them) "
+            "and DIR/design_chart.parquet (one row per cell). Link mass and inertia scale with the length "
+            "(docs/studies.md). Exit code 1 when a feasible cell did not finish."
+        ),
+    )
+    _add_out_option(chart)
+    chart.add_argument("--radius-mm", metavar="MM", nargs="+", help="curvature radii R [mm] (default 1000 1500 2000 3000 4000)")
+    chart.add_argument("--length-mm", metavar="MM", nargs="+", help="joint lengths L [mm] (default 150 200 300 400 500 1000)")
+    chart.add_argument("--tube-id", metavar="MM", help="inner diameter D of the guide tube [mm] (default 116, the paper's)")
+    chart.add_argument("--joint-od", metavar="MM", help="outer diameter d of the joint [mm] (default 86, the paper's)")
+    chart.add_argument(
+        "--hinge", choices=("ball-keys", "ideal-cv"), default="ball-keys",
+        help="hinge model (default ball-keys, the paper's; ideal-cv is ~7x faster but has no keys and about half "
+        "the tube force, docs/studies.md)",
+    )
+    chart.add_argument("--duration", metavar="S", help="simulated time per cell [s] (default 1.8)")
+    chart.add_argument(
+        "--window", metavar=("START", "END"), nargs=2, help="summary window of the tube forces [s] (default: the run's second half)"
+    )
+    chart.add_argument("--fixed-mass", action="store_true", help="keep the base link's mass and inertia at every length")
+    chart.add_argument("--workers", metavar="N", type=_workers, help="local threads running cells (default: one per CPU)")
+    chart.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS; needs ballcage[dask]")
+    _add_set_option(chart, example="--set drive.speed_rpm=60 --set pipe.joints=8")
+    _add_quiet_option(chart, "no estimate, progress or summary lines")
+    chart.set_defaults(command=_chart)
+
+
+def _chart(args: argparse.Namespace) -> int:
+    from ballcage import sizing
+    from ballcage.studies.design_chart import DEFAULT_DURATION, command  # deferred: pyarrow, numpy, matplotlib
+    from ballcage.studies.sweep_spec import SweepError
+
+    def metres(option: str, text: str | None) -> float | None:
+        value = _positive(option, text, "a positive length in mm")
+        return None if value is None else value / 1e3
+
+    inputs: dict[str, object] = {"hinge": args.hinge, "scale_mass": not args.fixed_mass}
+    for option, key, texts in (("--radius-mm", "radii", args.radius_mm), ("--length-mm", "lengths", args.length_mm)):
+        if texts is not None:
+            inputs[key] = [metres(option, t) for t in texts]
+    tube, joint = metres("--tube-id", args.tube_id), metres("--joint-od", args.joint_od)
+    bore = tube or sizing.PAPER_TUBE_INNER_DIAMETER
+    if joint is not None and joint >= bore:
+        raise UsageError(f"--joint-od {args.joint_od}: not narrower than the tube, --tube-id {1e3 * bore:g}")
+    inputs.update(tube_inner_diameter=tube, joint_diameter=joint)
+    inputs["duration"] = _positive("--duration", args.duration) or DEFAULT_DURATION
+    if args.window is not None:
+        try:
+            inputs["window"] = (float(args.window[0]), float(args.window[1]))
+        except ValueError:
+            raise UsageError(f"--window {' '.join(args.window)}: give START END in seconds, e.g. --window 0.9 1.8") from None
+    args.overrides = [_checked_override(o) for o in args.overrides]
+    _checked_out(args.out)
+    try:
+        return command(args, **inputs)
     except SweepError as e:
         raise UsageError(str(e)) from e
 
@@ -646,12 +729,26 @@ def _stability(args: argparse.Namespace) -> int:
 def _paper(args: argparse.Namespace) -> int:
     from ballcage.paper import run_paper  # deferred: imports matplotlib
 
+    from ballcage.studies.sweep_run import connect
+    from ballcage.studies.sweep_spec import SweepError
+
     overrides = [_checked_override(o) for o in args.overrides]
     out = _checked_out(args.out)
+    if (args.workers or args.scheduler) and not args.sweeps:
+        raise UsageError(f"--{'workers' if args.workers else 'scheduler'}: only with --sweeps (it sets where the sweep runs)")
+    client = None
     try:
-        paths = run_paper(out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None)
+        client = connect(args.scheduler) if args.scheduler else None
+        paths = run_paper(
+            out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None, workers=args.workers, client=client
+        )
     except _native.SceneError as e:
         raise UsageError(f"{DEFAULT_SCENE_NAME}: {e}") from e
+    except SweepError as e:
+        raise UsageError(str(e)) from e
+    finally:
+        if client is not None:
+            client.close()
     if not args.quiet:
         for name, path in paths.items():
             print(_paper_summary(name, path))
@@ -660,13 +757,13 @@ def _paper(args: argparse.Namespace) -> int:
 
 def _paper_summary(name: str, path: Path) -> str:
     if path.is_dir():
-        return f"wrote {path}/  (sweep variant {name.removeprefix('sweep_')})"
+        return f"wrote {path}/  (the section-4 sweep: summary.parquet, the cases' tables, plots/)"
     if path.suffix == ".parquet":
         import pyarrow.parquet as pq
 
         meta = pq.ParquetFile(path).metadata
         return f"wrote {path}  ({meta.num_rows} rows x {meta.num_columns} columns, {_human_size(path.stat().st_size)})"
-    what = {"scene": "resolved scene", "comparison_md": "comparison"}.get(name, "figure" if path.suffix == ".png" else name)
+    what = {"scene": "resolved scene", "comparison_md": "comparison and trends"}.get(name, "figure" if path.suffix == ".png" else name)
     return f"wrote {path}  ({what}, {_human_size(path.stat().st_size)})"
 
 
@@ -719,6 +816,14 @@ def _schema(args: argparse.Namespace) -> int:
         blocks.append("\n".join(lines))
     print("\n\n".join(blocks))
     return 0
+
+
+def _write_error(error: OSError) -> str:
+    """``cannot write <path>: <reason> (errno N)`` for an `OSError` naming its file; else ``cannot write output: <error>``."""
+    if error.filename is None:
+        return f"cannot write output: {error}"
+    number = f" (errno {error.errno})" if error.errno else ""
+    return f"cannot write {os.fsdecode(error.filename)}: {error.strerror or error}{number}"
 
 
 def _fail(message: str, code: int) -> int:

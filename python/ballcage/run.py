@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from ballcage import _native
-from ballcage._files import write_atomically
+from ballcage._files import write_all_atomically
 from ballcage.scene import SceneSource, load_scene
 
 if TYPE_CHECKING:
@@ -103,8 +103,11 @@ class Run:
         The directory is created if needed. Each file is written atomically:
         a reader sees either the previous file or the complete new one, and a
         failed write leaves no file under the final name and no temporary file.
+        All files are written to temporaries before any is renamed, so a
+        write that fails (a full disk: `OSError` naming the file) changes none
+        of the folder's files.
         Tables of an earlier run in the same directory that this run did not
-        record (``<table>.parquet`` for a name in ``ballcage.TABLE_NAMES``) are
+        record (``<table>.parquet`` of any table ``ballcage schema`` lists) are
         removed afterwards, so the folder never mixes two runs; other files
         are left alone. Returns the written paths, keyed by table name and ``"scene"``.
         """
@@ -113,17 +116,20 @@ class Run:
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         written: dict[str, Path] = {}
+        writers: dict[Path, Callable[[Path], object]] = {}
         for name, table in self.tables.items():
             path = out / f"{name}.parquet"
 
             def write_parquet(tmp: Path, table: pa.Table = table) -> None:
                 pq.write_table(table, str(tmp), compression="zstd")
 
-            write_atomically(path, write_parquet)
+            writers[path] = write_parquet
             written[name] = path
         scene_path = out / "scene.toml"
-        write_atomically(scene_path, lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8"))
+        writers[scene_path] = lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8")
         written["scene"] = scene_path
+        # Every temporary first, then the renames: a failed write (a full disk) leaves the folder as it was.
+        write_all_atomically(writers)
         for name in _native.TABLE_NAMES:
             if name not in self.tables:
                 (out / f"{name}.parquet").unlink(missing_ok=True)

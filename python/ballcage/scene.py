@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any, Self, TypeAlias
 
 from ballcage import _native
+from ballcage._native import InputError
 
 __all__ = ["DrillPipeBuilder", "SceneBuilder", "SceneSource", "default_scene", "default_scene_toml", "load_scene"]
 
@@ -211,7 +212,7 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
     error at line 2, column 7: …`` or ``bad.toml: scene field `…` = …: …``.
     """
     if isinstance(overrides, str):
-        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+        raise InputError("overrides is a list of 'key=value' strings, not one string")
     patches = list(overrides)
     if isinstance(source, _native.Scene):
         return _native.Scene.from_toml(source.to_toml(), patches) if patches else source
@@ -225,7 +226,7 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
             return _native.Scene.from_toml(text, patches)
         except _native.SceneError as e:
             raise _in_file(e, source) from None
-    raise TypeError(
+    raise InputError(
         f"cannot load a scene from {type(source).__name__}: give a path to a TOML file, "
         "a dict, a SceneBuilder or a ballcage.Scene"
     )
@@ -244,13 +245,13 @@ def default_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     expanded scene that ``Scene.to_toml()`` returns. Raises `ballcage.SceneError`.
     """
     if isinstance(overrides, str):
-        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+        raise InputError("overrides is a list of 'key=value' strings, not one string")
     return _native.Scene.from_toml(_native.default_scene_toml(), list(overrides))
 
 
 def _read_scene_file(source: str | os.PathLike[str]) -> str:
     if isinstance(source, str) and "\n" in source:
-        raise ValueError("load_scene takes a path, not TOML text: use ballcage.Scene.from_toml(text)")
+        raise InputError("load_scene takes a path, not TOML text: use ballcage.Scene.from_toml(text)")
     path = Path(source)
     try:
         return path.read_text(encoding="utf-8")
@@ -259,10 +260,11 @@ def _read_scene_file(source: str | os.PathLike[str]) -> str:
 
 
 def _in_file(error: _native.SceneError, source: str | os.PathLike[str]) -> _native.SceneError:
-    """`error` with the scene file's path in front of its message; ``path``, ``value`` and ``reason`` kept."""
+    """`error` with the scene file's path in front of its message; ``path``, ``value``, ``reason`` and ``errors`` kept."""
     named = _native.SceneError(f"{os.fspath(source)}: {error}")
     for attribute in ("path", "value", "reason"):
         setattr(named, attribute, getattr(error, attribute, ""))
+    named.errors = list(getattr(error, "errors", []))
     return named
 
 

@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ballcage import _native
+from ballcage._native import InputError
 
 __all__ = [
     "PAPER_JOINT_OUTER_DIAMETER",
@@ -49,7 +50,7 @@ PAPER_JOINT_OUTER_DIAMETER = 0.086
 def _positive(name: str, value: float) -> float:
     value = float(value)
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} = {value!r} m: must be a positive, finite length in metres")
+        raise InputError(f"{name} = {value!r} m: must be a positive, finite length in metres")
     return value
 
 
@@ -57,14 +58,14 @@ def _joint_in_tube(tube_inner_diameter: float, joint_outer_diameter: float) -> t
     tube = _positive("tube_inner_diameter", tube_inner_diameter)
     joint = _positive("joint_outer_diameter", joint_outer_diameter)
     if joint >= tube:
-        raise ValueError(f"joint_outer_diameter = {joint} m: not narrower than the bore, tube_inner_diameter = {tube} m")
+        raise InputError(f"joint_outer_diameter = {joint} m: not narrower than the bore, tube_inner_diameter = {tube} m")
     return tube, joint
 
 
 def _bend(curvature_radius: float, tube_inner_diameter: float) -> float:
     radius = _positive("curvature_radius", curvature_radius)
     if radius < tube_inner_diameter / 2:
-        raise ValueError(
+        raise InputError(
             f"curvature_radius = {radius} m: below half the bore ({tube_inner_diameter / 2} m), "
             "a tube cannot bend that tightly"
         )
@@ -111,7 +112,7 @@ def largest_joint_diameter(joint_length: float, curvature_radius: float, tube_in
     r = _native.largest_link_radius(length, radius, tube)
     if r is None or r <= 0:
         most = _native.longest_link(radius, tube, 0.0)
-        raise ValueError(
+        raise InputError(
             f"joint_length = {length} m: no joint that long fits a {tube} m bore bent to {radius} m "
             f"(eq. (9): at most {most:.6g} m, for a joint of no diameter)"
         )
@@ -128,7 +129,7 @@ def smallest_curvature_radius_for_bend(pitch: float, bend_limit_deg: float) -> f
     p = _positive("pitch", pitch)
     beta = float(bend_limit_deg)
     if not (math.isfinite(beta) and 0 < beta <= 180):
-        raise ValueError(f"bend_limit_deg = {beta!r}: must be an angle in (0, 180] degrees")
+        raise InputError(f"bend_limit_deg = {beta!r}: must be an angle in (0, 180] degrees")
     return _native.tightest_radius_for_bend(p, math.radians(beta))
 
 
@@ -155,7 +156,7 @@ def plot_joint_lengths(
     tube = _positive("tube_inner_diameter", tube_inner_diameter)
     diameters = [d for d in (joint_outer_diameters or _default_diameters(tube)) if 0 < d < tube]
     if not diameters:
-        raise ValueError(f"joint_outer_diameters: none is narrower than the bore, tube_inner_diameter = {tube} m")
+        raise InputError(f"joint_outer_diameters: none is narrower than the bore, tube_inner_diameter = {tube} m")
     fig = _plot.figure(figsize=(11, 4.5))
     left, right = fig.subplots(1, 2)
     radii = np.linspace(max(tube / 2, 0.1), max(3.0, 1.2 * mark[0] if mark else 0.0), 300)

@@ -111,7 +111,7 @@ impl Document {
                 // The reader validates; assembly does not do it again.
                 let scene = Scene::from_table(table, overrides)?;
                 let (model, state) = assemble_validated(&scene)?;
-                Ok(Self::from_parts(Source::Generic, scene, model, state))
+                Self::from_parts(Source::Generic, scene, model, state)
             }
             Kind::DrillPipe => {
                 // Sections and fields left out take the paper's values.
@@ -130,7 +130,7 @@ impl Document {
     /// A generic scene: validated and assembled.
     pub fn generic(scene: Scene) -> Result<Self, SceneError> {
         let (model, state) = assemble(&scene)?;
-        Ok(Self::from_parts(Source::Generic, scene, model, state))
+        Self::from_parts(Source::Generic, scene, model, state)
     }
 
     /// A drill-pipe scene: validated, expanded (which validates the
@@ -142,16 +142,23 @@ impl Document {
             spec: Box::new(spec),
             layout: Box::new(expansion.layout),
         };
-        Ok(Self::from_parts(source, expansion.scene, model, state))
+        Self::from_parts(source, expansion.scene, model, state)
     }
 
-    fn from_parts(source: Source, scene: Scene, model: Model, state: State) -> Self {
-        Self {
+    /// The document of assembled parts; refuses a start whose energy is not finite.
+    fn from_parts(
+        source: Source,
+        scene: Scene,
+        model: Model,
+        state: State,
+    ) -> Result<Self, SceneError> {
+        crate::sim::initial_energy_is_finite(&model, &state)?;
+        Ok(Self {
             source,
             scene,
             model,
             state,
-        }
+        })
     }
 
     /// The document's kind.
@@ -356,7 +363,16 @@ fn named_unit(key: &str) -> Option<&'static str> {
             &["duration", "dt", "output_interval", "ramp", "spin_ramp"],
             "s",
         ),
-        (&["joints", "tube_contact_points", "points", "threads"], "-"),
+        (
+            &[
+                "joints",
+                "tube_contact_points",
+                "points",
+                "threads",
+                "max_steps",
+            ],
+            "-",
+        ),
         (&["twist_stiffness", "stop_stiffness"], "N·m/rad"),
         (&["twist_damping"], "N·m·s/rad"),
         (&["stiffness"], "N/m"),

@@ -68,6 +68,7 @@ impl Simulation {
     /// `Document::simulation`, a layer above, with their observers.
     pub fn new(scene: &Scene) -> Result<Self, SceneError> {
         let (model, state) = assemble(scene)?;
+        initial_energy_is_finite(&model, &state)?;
         Ok(Self::from_model(model, state, vec![], scene.to_toml()))
     }
 
@@ -569,4 +570,38 @@ fn deepest_penetration(
         }
     }
     watch.deepest
+}
+
+/// Refuses a start whose energy overflows f64 (found by fuzzing: a
+/// velocity of 1e200 m/s, a ball overlapping the ground by 1e200 m): the
+/// frame at t = 0 would hold infinities, and no step could follow. Names
+/// the first body or pair whose energy is not finite.
+pub(crate) fn initial_energy_is_finite(model: &Model, state: &State) -> Result<(), SceneError> {
+    let energy = Dynamics::new(model).energy(model, state);
+    if energy.total().is_finite() {
+        return Ok(());
+    }
+    let body = model.integrated.iter().find(|&&i| {
+        let (b, w) = (&model.bodies[i], state.omega[i]);
+        let kinetic =
+            0.5 * b.mass * state.vel[i].norm_squared() + 0.5 * w.dot(&b.inertia.component_mul(&w));
+        let gravity = b.mass * model.gravity.dot(&state.pos[i]);
+        !(kinetic.is_finite() && gravity.is_finite())
+    });
+    let culprit = match body {
+        Some(&i) => format!(
+            "body `{}` (its mass, velocity or position)",
+            model.bodies[i].name
+        ),
+        None => "a contact pair's overlap (a body placed far inside another)".to_string(),
+    };
+    Err(SceneError::new(
+        "",
+        "",
+        format!(
+            "the state at t = 0 has no finite energy (kinetic {:e} J, gravitational {:e} J, contact {:e} J): \
+             {culprit} is too large to compute with",
+            energy.kinetic, energy.potential_gravity, energy.potential_contact
+        ),
+    ))
 }

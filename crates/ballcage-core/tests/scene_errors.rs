@@ -150,3 +150,179 @@ fn a_wrong_type_is_named_in_words_not_rust_types() {
     assert!(e.reason.contains("expected a number"), "{e}");
     assert!(!e.reason.contains("f64"), "{e}");
 }
+
+#[test]
+fn every_unknown_key_and_wrong_type_is_listed_in_one_error() {
+    let e = error_of(
+        GOOD,
+        &[
+            "simulation.duraton=1",
+            "bodies[1].mas=2",
+            "bodies[1].position=\"up\"",
+        ],
+    );
+    let mut paths: Vec<&str> = e.each().map(|x| x.path.as_str()).collect();
+    paths.sort_unstable();
+    assert_eq!(
+        paths,
+        ["bodies[1].mas", "bodies[1].position", "simulation.duraton"],
+        "{e}"
+    );
+    let mas = e.each().find(|x| x.path == "bodies[1].mas").unwrap();
+    assert!(mas.reason.ends_with("did you mean `mass`?"), "{e}");
+    // one message, every error in it, separated by "; "
+    assert_eq!(e.to_string().matches("scene field `").count(), 3, "{e}");
+}
+
+#[test]
+fn a_key_taken_out_after_its_own_error_is_not_reported_missing_as_well() {
+    // `dt` is required: its wrong type is one error, not also "missing field `dt`"
+    let e = error_of(GOOD, &["simulation.dt=\"fast\""]);
+    assert_eq!(e.path, "simulation.dt");
+    assert!(e.more.is_empty(), "{e}");
+}
+
+#[test]
+fn range_errors_of_independent_bodies_and_sections_are_all_listed() {
+    let e = error_of(
+        GOOD,
+        &[
+            "bodies[1].mass=-2",
+            "world.gravity=[0.0, 0.0, nan]",
+            "simulation.duration=-1",
+        ],
+    );
+    let mut paths: Vec<&str> = e.each().map(|x| x.path.as_str()).collect();
+    paths.sort_unstable();
+    assert_eq!(
+        paths,
+        ["bodies[1].mass", "simulation.duration", "world.gravity[2]"],
+        "{e}"
+    );
+}
+
+#[test]
+fn a_drill_pipe_lists_the_errors_of_its_independent_sections() {
+    use ballcage_core::loader::Document;
+    let text = ballcage_core::loader::default_document().to_toml();
+    let overrides: Vec<String> = [
+        "drive.ramp=-1",
+        "load.resisting_moment=nan",
+        "pipe.joints=0",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let e = match Document::from_toml_str(&text, &overrides) {
+        Ok(_) => panic!("scene was accepted"),
+        Err(e) => e,
+    };
+    let mut paths: Vec<&str> = e.each().map(|x| x.path.as_str()).collect();
+    paths.sort_unstable();
+    assert_eq!(
+        paths,
+        ["drive.ramp", "load.resisting_moment", "pipe.joints"],
+        "{e}"
+    );
+}
+
+/// The drill-pipe error of the default document with `overrides`.
+fn pipe_error_of(overrides: &[&str]) -> SceneError {
+    let text = ballcage_core::loader::default_document().to_toml();
+    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    match ballcage_core::loader::Document::from_toml_str(&text, &o) {
+        Ok(_) => panic!("scene was accepted"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn a_summary_window_past_the_run_is_refused() {
+    // GOOD runs 0.01 s: a window ending at 0.01 s is the whole run, 0.02 s reaches past it
+    assert!(Scene::from_toml_str(GOOD, &["record.summary_window=[0.0, 0.01]".into()]).is_ok());
+    let e = error_of(GOOD, &["record.summary_window=[0.0, 0.02]"]);
+    assert_eq!(e.path, "record.summary_window[1]");
+    assert!(e.reason.contains("simulation.duration = 0.01 s"), "{e}");
+}
+
+#[test]
+fn dynamic_friction_above_static_friction_is_refused() {
+    // the paper's tube friction: mu_static 0.3; 0.3 is allowed, 0.31 is not
+    let text = ballcage_core::loader::default_document().to_toml();
+    let ok: Vec<String> = vec!["materials.tube.friction.mu_dynamic=0.3".into()];
+    assert!(ballcage_core::loader::Document::from_toml_str(&text, &ok).is_ok());
+    let e = pipe_error_of(&["materials.tube.friction.mu_dynamic=0.31"]);
+    assert!(e.path.ends_with("friction.mu_dynamic"), "{e}");
+    assert!(e.reason.contains("mu_static = 0.3"), "{e}");
+}
+
+#[test]
+fn a_race_contact_angle_of_90_degrees_or_more_is_refused() {
+    let e = pipe_error_of(&["pipe.ball_keys.contact_angle_deg=90"]);
+    assert_eq!(e.path, "pipe.ball_keys.contact_angle_deg");
+    let text = ballcage_core::loader::default_document().to_toml();
+    let ok: Vec<String> = vec!["pipe.ball_keys.contact_angle_deg=60".into()];
+    assert!(ballcage_core::loader::Document::from_toml_str(&text, &ok).is_ok());
+}
+
+#[test]
+fn a_run_of_more_steps_than_max_steps_is_refused_with_the_count() {
+    // 0.01 s at 1e-4 s is 100 steps: a limit of 100 runs, 99 does not
+    assert!(Scene::from_toml_str(GOOD, &["simulation.max_steps=100".into()]).is_ok());
+    let e = error_of(GOOD, &["simulation.max_steps=99"]);
+    assert_eq!(e.path, "simulation.dt");
+    assert!(e.reason.starts_with("1.000e2 steps"), "{e}");
+    // the example: a 1 ns step for an hour, 3.6e12 steps against the default 1e8
+    let e = error_of(
+        GOOD,
+        &[
+            "simulation.dt=1e-9",
+            "simulation.duration=3600",
+            "simulation.output_interval=1.0",
+        ],
+    );
+    assert!(e.reason.starts_with("3.600e12 steps"), "{e}");
+    assert!(e.reason.contains("simulation.max_steps = 1.000e8"), "{e}");
+}
+
+#[test]
+fn a_ball_too_small_for_its_mass_properties_is_refused_not_nan() {
+    // fuzz/regressions/ball-radius-underflow-nan-inertia.toml: r³·4π/3 underflows to 0 at r = 1e-200 m,
+    // so the inertia m·i₁/m₁ would be 0/0
+    let e = error_of(GOOD, &["bodies[1].shape.radius=1e-200"]);
+    assert_eq!(e.path, "bodies[1].inertia", "{e}");
+    assert!(Scene::from_toml_str(GOOD, &["bodies[1].shape.radius=1e-3".into()]).is_ok());
+}
+
+#[test]
+fn a_spin_speed_on_a_body_that_does_not_spin_is_refused() {
+    // fuzz/regressions/dynamic-body-nan-spin-speed.toml
+    let e = error_of(GOOD, &["bodies[1].spin_speed=nan"]);
+    assert_eq!(e.path, "bodies[1].spin_speed", "{e}");
+    let e = error_of(GOOD, &["bodies[1].spin_ramp=-inf"]);
+    assert_eq!(e.path, "bodies[1].spin_ramp", "{e}");
+}
+
+#[test]
+fn a_start_whose_energy_overflows_is_refused_naming_the_body() {
+    // fuzz/regressions/huge-velocity-infinite-kinetic-energy.toml: ½·m·v² overflows above ~1.3e154 m/s
+    let e = error_of(GOOD, &["bodies[1].velocity=[1e200, 0.0, 0.0]"]);
+    assert!(e.reason.contains("body `ball`"), "{e}");
+    assert!(e.reason.contains("kinetic inf J"), "{e}");
+    assert!(Scene::from_toml_str(GOOD, &["bodies[1].velocity=[1e3, 0.0, 0.0]".into()]).is_ok());
+}
+
+#[test]
+fn a_cage_inertia_and_a_pitch_radius_outside_the_cage_are_refused() {
+    // fuzz/regressions/ideal-cv-nan-cage-inertia.toml and summary-rms-overflow.toml
+    let e = pipe_error_of(&[
+        "pipe.hinge=\"ideal-cv\"",
+        "pipe.ball_keys.cage_inertia[1]=nan",
+    ]);
+    assert_eq!(e.path, "pipe.ball_keys.cage_inertia[1]", "{e}");
+    let e = pipe_error_of(&["pipe.ball_keys.pitch_radius=3.15e98"]);
+    assert_eq!(e.path, "pipe.ball_keys.pitch_radius", "{e}");
+    // the paper's keys sit at 31.5 mm, in the 31-32 mm cage wall; 40 mm is beyond 32 + 7.5 mm
+    let e = pipe_error_of(&["pipe.ball_keys.pitch_radius=0.040"]);
+    assert_eq!(e.path, "pipe.ball_keys.pitch_radius", "{e}");
+}

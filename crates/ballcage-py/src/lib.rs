@@ -4,48 +4,165 @@
 //! pyarrow zero-copy through the Arrow PyCapsule interface (pyo3-arrow).
 
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::{Arc, Mutex};
 
 use ballcage_core::drillpipe::sizing;
 use ballcage_core::loader::{self, Document, Kind};
 use ballcage_core::scene::{IntegratorKind, whole_multiple as core_whole_multiple};
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyException, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyTuple, PyType};
 use pyo3_arrow::{PySchema, PyTable};
 
 create_exception!(
-    _native,
-    SceneError,
-    PyValueError,
-    "A scene field is missing or invalid; `.path` names it."
-);
-create_exception!(
-    _native,
-    SimulationError,
-    PyRuntimeError,
-    "A run stopped because its state stopped being physical."
+    ballcage._native,
+    Error,
+    PyException,
+    "Base class of every error ballcage raises: `except ballcage.Error` catches them all."
 );
 
+/// The subclasses of `Error`, each also a subclass of the built-in exception
+/// that code written before them catches (`ValueError`, `RuntimeError`).
+struct ErrorTypes {
+    scene: Py<PyType>,
+    simulation: Py<PyType>,
+    input: Py<PyType>,
+    internal: Py<PyType>,
+}
+
+static ERROR_TYPES: PyOnceLock<ErrorTypes> = PyOnceLock::new();
+
+/// `type(name, (Error, *builtins), {...})`, in module `ballcage._native`.
+fn error_subclass(
+    py: Python<'_>,
+    name: &str,
+    builtins: &[Bound<'_, PyType>],
+    doc: &str,
+) -> PyResult<Py<PyType>> {
+    let mut bases = vec![py.get_type::<Error>()];
+    bases.extend(builtins.iter().cloned());
+    let namespace = PyDict::new(py);
+    namespace.set_item("__doc__", doc)?;
+    namespace.set_item("__module__", "ballcage._native")?;
+    let made = py
+        .get_type::<PyType>()
+        .call1((name, PyTuple::new(py, bases)?, namespace))?;
+    Ok(made.cast_into::<PyType>()?.unbind())
+}
+
+fn error_types(py: Python<'_>) -> PyResult<&ErrorTypes> {
+    ERROR_TYPES.get_or_try_init(py, || {
+        let value = py.get_type::<PyValueError>();
+        let runtime = py.get_type::<PyRuntimeError>();
+        Ok(ErrorTypes {
+            scene: error_subclass(
+                py,
+                "SceneError",
+                std::slice::from_ref(&value),
+                "A scene field is missing or invalid; `.path`, `.value` and `.reason` name it.",
+            )?,
+            simulation: error_subclass(
+                py,
+                "SimulationError",
+                std::slice::from_ref(&runtime),
+                "A run stopped because its state stopped being physical.",
+            )?,
+            input: error_subclass(
+                py,
+                "InputError",
+                &[value, py.get_type::<PyTypeError>()],
+                "An argument of a ballcage function is invalid (out of range, or of the wrong type); \
+                 the message names it, its value and the reason.",
+            )?,
+            internal: error_subclass(
+                py,
+                "InternalError",
+                &[runtime],
+                "A bug in ballcage (a Rust panic, caught): the message says where; please report it.",
+            )?,
+        })
+    })
+}
+
+/// An exception of one of the `ErrorTypes` with `message`.
+fn raise(py: Python<'_>, pick: fn(&ErrorTypes) -> &Py<PyType>, message: String) -> PyErr {
+    match error_types(py) {
+        Ok(types) => PyErr::from_type(pick(types).bind(py).clone(), message),
+        Err(e) => e,
+    }
+}
+
 fn scene_err(py: Python<'_>, e: ballcage_core::SceneError) -> PyErr {
-    // An error of the document as a whole (a TOML syntax error) names no field.
-    let message = if e.path.is_empty() {
-        e.reason.clone()
-    } else {
-        e.to_string()
-    };
-    let err = SceneError::new_err(message);
+    // Every error found in one pass, "; "-separated; a document error (TOML syntax) names no field.
+    let err = raise(py, |t| &t.scene, e.to_string());
     let value = err.value(py);
-    // Attributes for programmatic access; setting them on a fresh exception cannot fail in practice.
+    // Attributes for programmatic access (the first error's, and all of them in `errors`);
+    // setting them on a fresh exception cannot fail in practice.
     let _ = value.setattr("path", e.path.clone());
     let _ = value.setattr("value", e.value.clone());
     let _ = value.setattr("reason", e.reason.clone());
+    let each: Vec<(String, String, String)> = e
+        .each()
+        .map(|x| (x.path.clone(), x.value.clone(), x.reason.clone()))
+        .collect();
+    let _ = value.setattr("errors", each);
     err
 }
 
-fn sim_err(e: ballcage_core::SimulationError) -> PyErr {
-    SimulationError::new_err(e.to_string())
+fn sim_err(py: Python<'_>, e: ballcage_core::SimulationError) -> PyErr {
+    raise(py, |t| &t.simulation, e.to_string())
+}
+
+fn input_err(py: Python<'_>, message: String) -> PyErr {
+    raise(py, |t| &t.input, message)
+}
+
+/// Where the last panic happened (`file:line`), recorded by the panic hook
+/// `quiet_panic_hook` installs; a worker thread's panic is read on the
+/// thread that catches it, hence a global, not a thread-local.
+static LAST_PANIC_AT: Mutex<Option<String>> = Mutex::new(None);
+
+/// Replaces the default panic hook, which prints a multi-line report to
+/// stderr, by one that only records where the panic happened: `guard` puts
+/// that into the one-line `InternalError`.
+fn quiet_panic_hook() {
+    std::panic::set_hook(Box::new(|info| {
+        let at = info
+            .location()
+            .map(|l| format!("{}:{}", l.file(), l.line()));
+        if let Ok(mut last) = LAST_PANIC_AT.lock() {
+            *last = at;
+        }
+    }));
+}
+
+/// Runs `f`, turning a Rust panic into an `InternalError` naming `what`,
+/// the panic's message and where it happened, so a bug never aborts or
+/// escapes as a `BaseException`.
+fn guard<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, String> {
+    catch_unwind(AssertUnwindSafe(f)).map_err(|payload| {
+        let message = payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "no message".to_owned());
+        let at = LAST_PANIC_AT
+            .lock()
+            .ok()
+            .and_then(|mut last| last.take())
+            .map(|at| format!(" at {at}"))
+            .unwrap_or_default();
+        format!(
+            "internal error in {what}: {message}{at} (a bug in ballcage; please report it with the scene)"
+        )
+    })
+}
+
+fn internal_err(py: Python<'_>, message: String) -> PyErr {
+    raise(py, |t| &t.internal, message)
 }
 
 /// A validated, assembled scene document of any kind.
@@ -84,9 +201,12 @@ impl Scene {
     #[staticmethod]
     #[pyo3(signature = (text, overrides = Vec::new()))]
     fn from_toml(py: Python<'_>, text: &str, overrides: Vec<String>) -> PyResult<Self> {
-        Document::from_toml_str(text, &overrides)
-            .map(|inner| Self { inner })
-            .map_err(|e| scene_err(py, e))
+        guard("Scene.from_toml", || {
+            Document::from_toml_str(text, &overrides)
+        })
+        .map_err(|m| internal_err(py, m))?
+        .map(|inner| Self { inner })
+        .map_err(|e| scene_err(py, e))
     }
 
     /// Validates a dict with the structure of a TOML scene.
@@ -103,9 +223,12 @@ impl Scene {
                 ballcage_core::SceneError::new("", "", format!("not a scene table: {e}")),
             )
         })?;
-        Document::from_table(table, &overrides)
-            .map(|inner| Self { inner })
-            .map_err(|e| scene_err(py, e))
+        guard("Scene.from_dict", || {
+            Document::from_table(table, &overrides)
+        })
+        .map_err(|m| internal_err(py, m))?
+        .map(|inner| Self { inner })
+        .map_err(|e| scene_err(py, e))
     }
 
     /// The resolved scene as TOML, every default written out; with `units`,
@@ -165,7 +288,7 @@ impl Scene {
     fn value<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
         let v = self.inner.value(key).map_err(|e| scene_err(py, e))?;
         pythonize::pythonize(py, &v)
-            .map_err(|e| PyRuntimeError::new_err(format!("scene value `{key}`: {e}")))
+            .map_err(|e| internal_err(py, format!("scene value `{key}`: {e}")))
     }
 
     /// The tightest guide-tube curvature radius [m] the drill pipe allows.
@@ -202,9 +325,10 @@ impl Scene {
     fn centreline<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
         let (spec, layout) = self.drill_pipe(py, "centreline")?;
         if count < 2 {
-            return Err(PyValueError::new_err(format!(
-                "count = {count}: must be at least 2 points"
-            )));
+            return Err(input_err(
+                py,
+                format!("count = {count}: must be at least 2 points"),
+            ));
         }
         let path = spec.extended_centreline();
         let (mut point, mut tangent, mut outward, mut s) = (vec![], vec![], vec![], vec![]);
@@ -243,12 +367,23 @@ impl Scene {
 #[pyclass(module = "ballcage._native")]
 struct Simulation {
     inner: Option<ballcage_core::Simulation>,
+    /// Feature `test-panic`: `advance` panics, for the test that a panic reaches Python as `InternalError`.
+    #[cfg(feature = "test-panic")]
+    panic_in_advance: bool,
 }
 
+/// The scene name that makes `advance` panic when built with feature `test-panic`.
+#[cfg(feature = "test-panic")]
+const TEST_PANIC_SCENE: &str = "ballcage-test-panic";
+
 impl Simulation {
-    fn get(&self) -> PyResult<&ballcage_core::Simulation> {
+    fn get(&self, py: Python<'_>) -> PyResult<&ballcage_core::Simulation> {
         self.inner.as_ref().ok_or_else(|| {
-            PyRuntimeError::new_err("the simulation was finished; its tables were handed over")
+            input_err(
+                py,
+                "the simulation was finished (or dropped after an internal error); its tables were handed over"
+                    .to_owned(),
+            )
         })
     }
 }
@@ -256,42 +391,73 @@ impl Simulation {
 #[pymethods]
 impl Simulation {
     #[new]
-    fn new(scene: &Scene) -> Self {
-        Self {
-            inner: Some(scene.inner.simulation()),
-        }
+    fn new(py: Python<'_>, scene: &Scene) -> PyResult<Self> {
+        let inner =
+            guard("Simulation()", || scene.inner.simulation()).map_err(|m| internal_err(py, m))?;
+        Ok(Self {
+            inner: Some(inner),
+            #[cfg(feature = "test-panic")]
+            panic_in_advance: scene.inner.scene().name == TEST_PANIC_SCENE,
+        })
     }
 
     /// Simulated time reached [s].
     #[getter]
-    fn time(&self) -> PyResult<f64> {
-        Ok(self.get()?.time())
+    fn time(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.get(py)?.time())
     }
 
     /// Scene duration [s].
     #[getter]
-    fn duration(&self) -> PyResult<f64> {
-        Ok(self.get()?.model().duration())
+    fn duration(&self, py: Python<'_>) -> PyResult<f64> {
+        Ok(self.get(py)?.model().duration())
     }
 
     /// Integrator steps taken.
     #[getter]
-    fn steps(&self) -> PyResult<u64> {
-        Ok(self.get()?.steps())
+    fn steps(&self, py: Python<'_>) -> PyResult<u64> {
+        Ok(self.get(py)?.steps())
     }
 
     /// Runs until `t_end` [s] (clamped to the duration), without the GIL.
+    ///
+    /// A panic inside (a bug) raises `InternalError` and drops the
+    /// simulation, whose state can no longer be trusted.
     fn advance(&mut self, py: Python<'_>, t_end: f64) -> PyResult<()> {
         if !t_end.is_finite() {
-            return Err(PyValueError::new_err(format!(
-                "t_end = {t_end}: must be a finite time in seconds"
-            )));
+            return Err(input_err(
+                py,
+                format!("t_end = {t_end}: must be a finite time in seconds"),
+            ));
         }
-        let sim = self
-            .inner
-            .as_mut()
-            .ok_or_else(|| PyRuntimeError::new_err("the simulation was finished"))?;
-        py.detach(|| sim.advance_to(t_end)).map_err(sim_err)
+        #[cfg(feature = "test-panic")]
+        let inject = self.panic_in_advance;
+        let sim = self.inner.as_mut().ok_or_else(|| {
+            input_err(
+                py,
+                "the simulation was finished (or dropped after an internal error)".to_owned(),
+            )
+        })?;
+        let outcome = py.detach(|| {
+            guard("Simulation.advance", || {
+                #[cfg(feature = "test-panic")]
+                assert!(
+                    !inject,
+                    "injected panic (feature test-panic, scene `{TEST_PANIC_SCENE}`)"
+                );
+                sim.advance_to(t_end)
+            })
+        });
+        match outcome {
+            Ok(result) => result.map_err(|e| sim_err(py, e)),
+            Err(message) => {
+                self.inner = None;
+                Err(internal_err(
+                    py,
+                    format!("{message}; the simulation was dropped"),
+                ))
+            }
+        }
     }
 
     /// Ends the run: one `pyarrow.Table` per recorded table, by name.
@@ -299,9 +465,12 @@ impl Simulation {
         let sim = self
             .inner
             .take()
-            .ok_or_else(|| PyRuntimeError::new_err("finish() was already called"))?;
-        let batches = ballcage_core::output::record_batches(sim.finish())
-            .map_err(|e| PyRuntimeError::new_err(format!("building Arrow tables failed: {e}")))?;
+            .ok_or_else(|| input_err(py, "finish() was already called".to_owned()))?;
+        let batches = guard("Simulation.finish", || {
+            ballcage_core::output::record_batches(sim.finish())
+        })
+        .map_err(|m| internal_err(py, m))?
+        .map_err(|e| internal_err(py, format!("building Arrow tables failed: {e}")))?;
         let out = PyDict::new(py);
         for (def, batch) in batches {
             let schema = batch.schema();
@@ -323,10 +492,10 @@ fn default_scene_toml() -> String {
 fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
     let def = loader::table(name).ok_or_else(|| {
         let names: Vec<&str> = loader::tables().iter().map(|t| t.name).collect();
-        PyValueError::new_err(format!(
-            "table `{name}`: unknown (tables are {})",
-            names.join(", ")
-        ))
+        input_err(
+            py,
+            format!("table `{name}`: unknown (tables are {})", names.join(", ")),
+        )
     })?;
     let schema = ballcage_core::output::schema(def, HashMap::new());
     PySchema::new(Arc::new(schema)).into_pyarrow(py)
@@ -388,8 +557,13 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
             "release"
         },
     )?;
-    m.add("SceneError", py.get_type::<SceneError>())?;
-    m.add("SimulationError", py.get_type::<SimulationError>())?;
+    quiet_panic_hook();
+    let types = error_types(py)?;
+    m.add("Error", py.get_type::<Error>())?;
+    m.add("SceneError", types.scene.bind(py))?;
+    m.add("SimulationError", types.simulation.bind(py))?;
+    m.add("InputError", types.input.bind(py))?;
+    m.add("InternalError", types.internal.bind(py))?;
     m.add_class::<Scene>()?;
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(table_schema, m)?)?;

@@ -15,8 +15,11 @@ every table recorded, and writes into one directory:
   definition of Table 3's range of motion that fits the paper, and
   ``head_cage_normal_peak_n``, which the paper does not report).
 
-With ``sweeps=True`` it also runs the curvature (R = 1.0, 2.5 m) and speed
-(60, 120 rpm) variants of §4.2–4.3 and fills the ``sweep_*`` rows.
+With ``sweeps=True`` it also runs the paper's §4.2–4.3 as one sweep
+(`section4`: R = 1.0–2.5 m, 60–120 rpm, and the baseline's run-to-run
+spread) into ``sweeps/``, fills the ``sweep_*`` rows, draws Figures 16–17
+(`section4_figures`) and checks the paper's ``[[trend]]`` claims (`trends`,
+``trends.parquet``).
 
 `comparison(run)` builds the comparison table from any run of the paper scene,
 so it can be checked on a short run. Everything is computed from the recorded
@@ -29,7 +32,8 @@ Modules, one job each: `running` (the scenes and `run_paper`), `definitions`
 and Table 3's phases), `motion` (Table 3's most deformed joint and range of
 motion: most frequent link, peak-to-peak excursion), `frames` (per-frame grids
 of the tables), `compare` (the comparison table), `markdown`
-(``comparison.md``), `figures` (the PNGs).
+(``comparison.md``), `figures` (the PNGs), `section4`, `section4_figures`
+and `trends` (the §4 sweep; imported on use, as they load the sweep machinery).
 """
 
 from ballcage.paper.compare import COMPARISON_SCHEMA, comparison
@@ -37,7 +41,7 @@ from ballcage.paper.definitions import EXTRA_ROWS, SWEEPS, TUBE_LINKS, reference
 from ballcage.paper.facts import PHASES
 from ballcage.paper.figures import FIGURES, KEY_BODIES, write_figures
 from ballcage.paper.markdown import comparison_markdown
-from ballcage.paper.running import PAPER_TABLES, SWEEP_TABLES, paper_scene, run_paper
+from ballcage.paper.running import PAPER_TABLES, paper_scene, run_paper
 
 __all__ = [
     "COMPARISON_SCHEMA",
@@ -47,7 +51,6 @@ __all__ = [
     "PAPER_TABLES",
     "PHASES",
     "SWEEPS",
-    "SWEEP_TABLES",
     "TUBE_LINKS",
     "comparison",
     "comparison_markdown",

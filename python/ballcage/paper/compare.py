@@ -356,7 +356,7 @@ def _cage_values(run: Run, times: np.ndarray) -> dict[str, _Value]:
 
 
 def _sweep_value(run: Run, variant: str, what: str) -> _Value:
-    label = SWEEPS.get(variant, (variant, variant))[1]
+    label = SWEEPS[variant].label if variant in SWEEPS else variant
     definition = SWEEP_DEFINITIONS[what].format(label=label)
     if what == "tube_mean_max":
         tube = link_tube_forces(run)

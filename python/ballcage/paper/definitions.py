@@ -8,26 +8,68 @@ from importlib import resources
 from typing import Any
 
 __all__ = [
+    "BASELINE_RADIUS",
+    "BASELINE_RPM",
     "DEFINITIONS",
     "EXTRA_ROWS",
+    "MUCH_LARGER",
+    "NORMAL_TANGENTIAL_PAIRS",
     "REFERENCE_FILE",
+    "SECTION4_RADII",
+    "SECTION4_SPEEDS",
     "SWEEPS",
     "SWEEP_DEFINITIONS",
+    "TREND_RULES",
     "TUBE_LINKS",
     "ExtraRow",
+    "SweepVariant",
     "reference",
 ]
 
 #: The reference file, in ``ballcage/data``.
 REFERENCE_FILE = "paper-2023.toml"
-#: Sweep variants of §4.2 (curvature) and §4.3 (speed): id → (override, label).
-#: The id is the one in the reference keys, ``sweep_<id>_...``.
-SWEEPS: dict[str, tuple[str, str]] = {
-    "R1000": ("borehole.curvature_radius=1.0", "R = 1.0 m"),
-    "R2500": ("borehole.curvature_radius=2.5", "R = 2.5 m"),
-    "rpm60": ("drive.speed_rpm=60", "60 rpm"),
-    "rpm120": ("drive.speed_rpm=120", "120 rpm"),
+
+
+@dataclass(frozen=True)
+class SweepVariant:
+    """A case of the paper's §4 sweep that the reference file quotes numbers for."""
+
+    radius: float  # borehole.curvature_radius [m]
+    rpm: float  # drive.speed_rpm [rpm]
+    label: str
+
+
+#: The section-4 cases with numbers in the reference file: id → variant. The id is the one in the reference
+#: keys, ``sweep_<id>_...``; every case of the sweep (`ballcage.paper.section4`) is in `SECTION4_RADII` or
+#: `SECTION4_SPEEDS`.
+SWEEPS: dict[str, SweepVariant] = {
+    "R1000": SweepVariant(1.0, 100.0, "R = 1.0 m"),
+    "R2500": SweepVariant(2.5, 100.0, "R = 2.5 m"),
+    "rpm60": SweepVariant(1.5, 60.0, "60 rpm"),
+    "rpm120": SweepVariant(1.5, 120.0, "120 rpm"),
 }
+#: §4.2: the curvature radii [m], at `BASELINE_RPM`; §4.3: the drive speeds [rpm], at `BASELINE_RADIUS`.
+SECTION4_RADII: tuple[float, ...] = (1.0, 1.5, 2.0, 2.5)
+SECTION4_SPEEDS: tuple[float, ...] = (60.0, 80.0, 100.0, 120.0)
+BASELINE_RADIUS = 1.5  # m, the paper's scene
+BASELINE_RPM = 100.0  # rpm
+
+#: How each ``[[trend]]`` of the reference file is checked: key → (summary column, swept scene key, +1 rises /
+#: -1 falls as the key grows). ``normal_exceeds_tangential`` is checked by `NORMAL_TANGENTIAL_PAIRS`.
+TREND_RULES: dict[str, tuple[str, str, int]] = {
+    "tube_mean_max_falls_with_R": ("tube_normal_mean_max_n", "borehole.curvature_radius", -1),
+    "key_peak_falls_with_R": ("key_peak_n", "borehole.curvature_radius", -1),
+    "tube_mean_max_rises_with_rpm": ("tube_normal_mean_max_n", "drive.speed_rpm", +1),
+    "key_peak_rises_with_rpm": ("key_peak_n", "drive.speed_rpm", +1),
+}
+#: ``normal_exceeds_tangential``: (normal column, tangential column) of the summary, on the tube and in the joints.
+NORMAL_TANGENTIAL_PAIRS: tuple[tuple[str, str], ...] = (
+    ("tube_normal_mean_all_n", "tube_tangential_mean_all_n"),
+    ("seat_key_normal_peak_n", "seat_key_tangential_peak_n"),
+)
+#: Our reading of "much larger" in ``normal_exceeds_tangential``: the normal force at least this many times the
+#: tangential one, in every case (the smallest ratio is reported beside the verdict).
+MUCH_LARGER = 3.0
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ballcage._native import InputError
 from ballcage.paper.frames import frame_grid, frame_times
 from ballcage.run import Run
 
@@ -42,7 +43,7 @@ def scene_facts(run: Run) -> SceneFacts:
     """Asks the run's scene for what the analysis needs; `ValueError` unless it is a drill pipe."""
     scene = run.scene
     if scene.kind != "drill-pipe":
-        raise ValueError(f"scene kind = {scene.kind!r}: the paper analysis needs a drill-pipe scene")
+        raise InputError(f"scene kind = {scene.kind!r}: the paper analysis needs a drill-pipe scene")
     return SceneFacts(
         duration=scene.duration,
         output_interval=scene.output_interval,

@@ -22,8 +22,10 @@ def comparison_markdown(
     command: str,
     run: Run | None = None,
     sweep_runs: Mapping[str, Run] | None = None,
+    section4: tuple[pa.Table, pa.Table] | None = None,
 ) -> str:
-    """``comparison.md``: a title, the command line, a short paragraph and the table."""
+    """``comparison.md``: a title, the command line, a short paragraph, the table and, with `section4`
+    (the sweep's summary and `ballcage.paper.trends.trend_table`), its cases and the paper's trends checked."""
     duration = ""
     if run is not None:
         facts = scene_facts(run)
@@ -31,7 +33,7 @@ def comparison_markdown(
             f"This run simulated {facts.duration:g} s (the paper: 1.8 s) at {facts.rpm:g} rpm in a "
             f"R = {facts.curvature_radius:g} m guide tube. "
         )
-    swept = ", ".join(SWEEPS[v][1] for v in (sweep_runs or {}) if v in SWEEPS)
+    swept = ", ".join(SWEEPS[v].label for v in (sweep_runs or {}) if v in SWEEPS)
     lines = [
         "# ballcage vs Zhu et al., Machines 2023, 11, 357",
         "",
@@ -46,7 +48,7 @@ def comparison_markdown(
             "The note says how our definition is computed, where it differs from the "
             "paper's, and when the paper's own value is suspect (it contradicts other numbers of the paper, "
             "see docs/model.md §6): compare those as order of magnitude only. Empty cells were not computed. "
-            + (f"Sweep variants run: {swept}." if swept else "Sweep rows need `--sweeps`.")
+            + (f"Section-4 cases with reference values: {swept}." if swept else "Sweep rows need `--sweeps`.")
         ),
         "",
         "| key | paper | ours | unit | ratio | note |",
@@ -62,7 +64,12 @@ def comparison_markdown(
             note = note.replace(phases["note"], "phases: listed under the table")
         note = note.replace("|", "\\|")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
-    return "\n".join(lines + _phase_lines(phases)) + "\n"
+    lines += _phase_lines(phases)
+    if section4 is not None:
+        from ballcage.paper.trends import trend_markdown  # deferred: it imports the sweep machinery
+
+        lines += trend_markdown(*section4)
+    return "\n".join(lines) + "\n"
 
 
 def _phase_lines(phases: Mapping[str, Any]) -> list[str]:

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ballcage._native import InputError
 from ballcage.paper.facts import SceneFacts
 from ballcage.paper.frames import frame_grid, frame_times
 from ballcage.run import Run
@@ -50,7 +51,7 @@ def most_frequent(links: Sequence[int], deformation: Sequence[float]) -> MostFre
     of its phases (then to the lower link number). `ValueError` on no phases.
     """
     if len(links) == 0 or len(links) != len(deformation):
-        raise ValueError(f"need one deformation per phase, got {len(links)} links and {len(deformation)} values")
+        raise InputError(f"need one deformation per phase, got {len(links)} links and {len(deformation)} values")
     counts = Counter(int(k) for k in links)
     top = max(counts.values())
     tied = tuple(sorted(k for k, c in counts.items() if c == top))

@@ -1,4 +1,4 @@
-"""Running the paper: the paper scene and its sweep variants, and `run_paper` writing everything."""
+"""Running the paper: the paper scene, its section-4 sweep, and `run_paper` writing everything."""
 
 from __future__ import annotations
 
@@ -7,22 +7,27 @@ import shlex
 import sys
 from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
+from ballcage._native import InputError
 from ballcage._files import write_parquet, write_text
 from ballcage.paper.compare import comparison
-from ballcage.paper.definitions import SWEEPS
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
-from ballcage.run import Run, simulate
+from ballcage.run import simulate
 from ballcage.scene import default_scene
 
-__all__ = ["PAPER_TABLES", "SWEEP_TABLES", "paper_scene", "run_paper"]
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+    from ballcage.paper.section4 import Section4
+    from ballcage.studies.sweep_spec import SweepSpec
+
+__all__ = ["PAPER_TABLES", "paper_scene", "run_paper"]
 
 #: Tables the paper run records.
 PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive")
-#: Tables the sweep variants record (enough for their comparison rows).
-SWEEP_TABLES: tuple[str, ...] = ("links", "keys")
 
 
 def run_paper(
@@ -30,70 +35,95 @@ def run_paper(
     overrides: Iterable[str] = (),
     sweeps: bool = False,
     progress: bool | None = None,
+    *,
+    workers: int | None = None,
+    client: Any = None,
 ) -> dict[str, Path]:
     """Runs the paper scene and writes tables, figures and the comparison into `out_dir`.
 
     `overrides` (``dotted.key=value``, on the drill-pipe TOML of
-    `ballcage.default_scene_toml`) apply to the main run and to every sweep
-    variant; a sweep's own key is applied last. `progress` is as for
-    `ballcage.simulate`; unless it is ``False``, a line on stderr also names
-    each sweep variant. Every scene is validated before anything runs.
+    `ballcage.default_scene_toml`) apply to the main run and to every case of
+    the section-4 sweep, whose own keys (curvature radius, drive speed) are
+    applied last. `progress` is as for `ballcage.simulate` and `ballcage.sweep`.
+    Every scene is validated before anything runs.
+
+    With `sweeps`, the paper's §4.2–4.3 run as one sweep (`ballcage.paper.section4`)
+    in `workers` local threads (default one per CPU) or on the Dask cluster of
+    `client`, into ``out_dir/sweeps`` (resumed when run again); its finished
+    cases fill the comparison's ``sweep_*`` rows, ``fig16_curvature.png`` and
+    ``fig17_speed.png``, and ``trends.parquet`` checks each ``[[trend]]`` of
+    the reference file, also listed in ``comparison.md``.
 
     Returns the written paths: one per table (``"bodies"``, …), ``"scene"``,
     one per figure (``"fig09_included_angles"``, …), ``"comparison"``,
-    ``"comparison_md"`` and, with `sweeps`, ``"sweep_<id>"`` (a directory with
-    that variant's tables). Raises `ballcage.SceneError` for an invalid
-    override and `ballcage.SimulationError` when a run diverges.
+    ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder),
+    ``"fig16_curvature"``, ``"fig17_speed"`` and ``"trends"``. Raises
+    `ballcage.SceneError` for an invalid override and `ballcage.SimulationError`
+    when the main run diverges (a sweep case that diverges is recorded in the
+    sweep's summary and its rows stay empty).
     """
     if isinstance(overrides, str):
-        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+        raise InputError("overrides is a list of 'key=value' strings, not one string")
+    from ballcage.paper.section4 import section4_spec  # deferred: the sweep machinery imports this package
+
     user = list(overrides)
     out = Path(out_dir)
     main_scene = paper_scene(user)
-    variants = {vid: paper_scene(user, sweep=vid) for vid in SWEEPS} if sweeps else {}
-
+    spec = section4_spec(user) if sweeps else None
+    if spec is not None:
+        spec.check()
     run = simulate(main_scene, progress=progress)
     written = run.write(out)
-    sweep_runs: dict[str, Run] = {}
-    for n, (vid, scene) in enumerate(variants.items(), start=1):
-        if progress is not False:
-            print(f"ballcage: sweep {SWEEPS[vid][1]} ({n}/{len(variants)})", file=sys.stderr, flush=True)
-        sweep_runs[vid] = simulate(scene, progress=progress)
-        sweep_dir = out / "sweeps" / vid
-        sweep_runs[vid].write(sweep_dir)
-        written[f"sweep_{vid}"] = sweep_dir
-
     written.update(write_figures(run, out))
-    table = comparison(run, sweep_runs if sweeps else None)
+    section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
+    sweep_runs = section4[0].variant_runs() if section4 is not None else None
+    table = comparison(run, sweep_runs)
     written["comparison"] = write_parquet(table, out / "comparison.parquet")
-    md = comparison_markdown(table, command=_command_line(out, user, sweeps), run=run, sweep_runs=sweep_runs)
+    md = comparison_markdown(
+        table,
+        command=_command_line(out, user, sweeps),
+        run=run,
+        sweep_runs=sweep_runs,
+        section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
+    )
     written["comparison_md"] = write_text(md, out / "comparison.md")
     return written
 
 
-def paper_scene(overrides: Iterable[str] = (), sweep: str | None = None) -> _native.Scene:
-    """The paper's scene as `run_paper` runs it: the default scene recording `PAPER_TABLES`, then
-    `overrides`; for a `sweep` id of `SWEEPS`, recording `SWEEP_TABLES` with that variant's key last.
+def _run_section4(
+    out: Path, spec: SweepSpec, written: dict[str, Path], client: Any, workers: int | None, progress: bool | None
+) -> tuple[Section4, pa.Table]:
+    """Runs the section-4 sweep into ``out/sweeps``, writes Figures 16–17 and ``trends.parquet`` (into `written`)."""
+    from ballcage.paper.section4 import run_section4
+    from ballcage.paper.section4_figures import write_section4_figures
+    from ballcage.paper.trends import trend_table
+
+    if progress is not False:
+        print("ballcage: the paper's section 4 (curvature and speed) as a sweep", file=sys.stderr, flush=True)
+    section4 = run_section4(out / "sweeps", spec, client=client, workers=workers, progress=progress)
+    written["sweeps"] = out / "sweeps"
+    written.update(write_section4_figures(section4.curvature_runs(), section4.speed_runs(), out))
+    trends = trend_table(section4.result.summary, section4.other_windows())
+    written["trends"] = write_parquet(trends, out / "trends.parquet")
+    return section4, trends
+
+
+def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
+    """The paper's scene as `run_paper` runs it: the default scene recording `PAPER_TABLES`, then `overrides`.
 
     Raises `ballcage.SceneError` for an invalid override or a ``record.tables``
-    override that drops a table the analysis needs, and `ValueError` for an
-    unknown `sweep`.
+    override that drops a table the analysis needs.
     """
     if isinstance(overrides, str):
-        raise TypeError("overrides is a list of 'key=value' strings, not one string")
-    if sweep is not None and sweep not in SWEEPS:
-        raise ValueError(f"sweep = {sweep!r}: not a sweep variant ({', '.join(SWEEPS)})")
-    tables = SWEEP_TABLES if sweep else PAPER_TABLES
-    record = "record.tables=[" + ", ".join(f'"{t}"' for t in tables) + "]"
-    patches = [record, *overrides]
-    if sweep is not None:
-        patches.append(SWEEPS[sweep][0])
-    scene = default_scene(patches)
-    missing = [t for t in tables if t not in scene.table_names]
+        raise InputError("overrides is a list of 'key=value' strings, not one string")
+    record = "record.tables=[" + ", ".join(f'"{t}"' for t in PAPER_TABLES) + "]"
+    scene = default_scene([record, *overrides])
+    missing = [t for t in PAPER_TABLES if t not in scene.table_names]
     if missing:
         reason = f"must include {', '.join(missing)} for the paper's figures and comparison"
         error = _native.SceneError(f"scene field `record.tables` = {scene.table_names}: {reason}")
         error.path, error.value, error.reason = "record.tables", str(scene.table_names), reason
+        error.errors = [(error.path, error.value, reason)]
         raise error
     return scene
 

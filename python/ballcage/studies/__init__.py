@@ -54,12 +54,15 @@ varied), `stability_search` (the stable-step search), `stability_run` and
 cases), `sweep_case` (one case on a worker: run, files, record),
 `sweep_quantities` (a case's derived quantities, by the paper module's
 definitions), `sweep_summary` (``summary.parquet``), `sweep_plots` and
-`sweep_run` (`sweep`: local threads or Dask, resume, progress).
+`sweep_run` (`sweep`: local threads or Dask, resume, progress); the design chart
+(``ballcage chart``): `design_chart` (cells, feasibility, the sweep of the
+feasible ones, ``design_chart.parquet``) and `design_chart_plot` (its figure).
 """
 
 from ballcage.studies.accuracy_report import accuracy_markdown, write_accuracy
 from ballcage.studies.accuracy_run import accuracy
 from ballcage.studies.common import StudyError, available_integrators
+from ballcage.studies.design_chart import DesignChart, design_chart
 from ballcage.studies.ladders import default_steps
 from ballcage.studies.scalars import FLOORS, MAX_QUANTITY, Quantity, quantities
 from ballcage.studies.schemas import ACCURACY_SCHEMA, STABILITY_SCHEMA
@@ -77,6 +80,7 @@ from ballcage.studies.sweep_spec import SweepError, SweepSpec, load_sweep
 
 __all__ = [
     "ACCURACY_SCHEMA",
+    "DesignChart",
     "FLOORS",
     "MAX_QUANTITY",
     "PARAMETER_NAMES",
@@ -92,6 +96,7 @@ __all__ = [
     "available_integrators",
     "load_sweep",
     "default_steps",
+    "design_chart",
     "drill_pipe_parameters",
     "probe_scene",
     "quantities",

@@ -12,6 +12,7 @@ from typing import Any
 import pyarrow as pa
 
 from ballcage import _native
+from ballcage._native import InputError
 from ballcage.run import Run, simulate
 from ballcage.scene import SceneSource, load_scene
 from ballcage.studies.common import (
@@ -98,9 +99,9 @@ def _floor_values(floors: Mapping[str, float] | None) -> dict[str, float]:
     out = {k: v for k, (v, _) in FLOORS.items()}
     for k, v in (floors or {}).items():
         if k not in FLOORS:
-            raise ValueError(f"floors: {k!r} is not a kind of quantity ({', '.join(FLOORS)})")
+            raise InputError(f"floors: {k!r} is not a kind of quantity ({', '.join(FLOORS)})")
         if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"floors[{k!r}] = {v!r}: must be positive")
+            raise InputError(f"floors[{k!r}] = {v!r}: must be positive")
         out[k] = float(v)
     return out
 

@@ -10,12 +10,13 @@ from collections.abc import Iterable, Mapping, Sequence
 import pyarrow as pa
 
 from ballcage import _native
+from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene, load_scene
 
 __all__ = ["StudyError", "available_integrators"]
 
 
-class StudyError(RuntimeError):
+class StudyError(_native.Error, RuntimeError):
     """A study that cannot go on, e.g. because its reference run diverged."""
 
 
@@ -35,7 +36,7 @@ def family(integrator: str) -> str:
     """
     facts = _native.integrator_facts()
     if integrator not in facts:
-        raise ValueError(f"integrator {integrator!r}: not an integrator (integrators: {', '.join(facts)})")
+        raise InputError(f"integrator {integrator!r}: not an integrator (integrators: {', '.join(facts)})")
     return "implicit" if facts[integrator]["implicit"] else "explicit"
 
 
@@ -45,18 +46,18 @@ def check_integrators(names: Iterable[str], what: str = "integrators") -> list[s
     out: list[str] = []
     for name in names:
         if name not in known:
-            raise ValueError(f"{what}: {name!r} is not an integrator (integrators: {', '.join(known)})")
+            raise InputError(f"{what}: {name!r} is not an integrator (integrators: {', '.join(known)})")
         if name not in out:
             out.append(name)
     if not out:
-        raise ValueError(f"{what}: name at least one integrator")
+        raise InputError(f"{what}: name at least one integrator")
     return out
 
 
 def check_duration(duration: float | None) -> None:
     """`ValueError` unless `duration` is ``None`` or a positive finite time [s]."""
     if duration is not None and not (math.isfinite(duration) and duration > 0):
-        raise ValueError(f"duration = {duration!r}: must be a positive time in seconds")
+        raise InputError(f"duration = {duration!r}: must be a positive time in seconds")
 
 
 # --------------------------------------------------------------------------- scenes
@@ -70,7 +71,7 @@ def is_drill_pipe(scene: _native.Scene) -> bool:
 def resolve(scene: SceneSource | None, overrides: Iterable[str]) -> _native.Scene:
     """`scene` (``None``: the embedded paper scene) validated with `overrides`."""
     if isinstance(overrides, str):
-        raise TypeError("overrides is a list of 'key=value' strings, not one string")
+        raise InputError("overrides is a list of 'key=value' strings, not one string")
     return default_scene(list(overrides)) if scene is None else load_scene(scene, list(overrides))
 
 

@@ -12,7 +12,7 @@ import math
 from collections.abc import Iterable, Mapping, Sequence
 
 from ballcage import _native
-from ballcage._native import whole_multiple
+from ballcage._native import InputError, whole_multiple
 from ballcage.studies.common import family, is_drill_pipe
 
 __all__ = ["DRILL_PIPE_STEPS", "GENERIC_STEP_FACTORS", "REFERENCE_DIVISOR", "default_steps"]
@@ -60,7 +60,7 @@ def ladders(
     if isinstance(steps, Mapping):
         unknown = [k for k in steps if k not in names]
         if unknown:
-            raise ValueError(f"steps: {unknown[0]!r} is not one of the studied integrators ({', '.join(names)})")
+            raise InputError(f"steps: {unknown[0]!r} is not one of the studied integrators ({', '.join(names)})")
     for name in names:
         if steps is None:
             out[name] = default_steps(scene, name)
@@ -79,7 +79,7 @@ def reference_step(
         ladder = ladders.get(integrator) or default_steps(scene, integrator)
         return min(ladder) / REFERENCE_DIVISOR
     if not (math.isfinite(reference_dt) and reference_dt > 0):
-        raise ValueError(f"reference_dt = {reference_dt!r}: must be a positive step in seconds")
+        raise InputError(f"reference_dt = {reference_dt!r}: must be a positive step in seconds")
     return reference_dt
 
 
@@ -89,10 +89,10 @@ def check_steps(steps: Iterable[float], what: str) -> tuple[float, ...]:
     for dt in steps:
         dt = float(dt)
         if not (math.isfinite(dt) and dt > 0):
-            raise ValueError(f"{what}: {dt!r} is not a positive step in seconds")
+            raise InputError(f"{what}: {dt!r} is not a positive step in seconds")
         out.append(dt)
     if not out:
-        raise ValueError(f"{what}: give at least one step")
+        raise InputError(f"{what}: give at least one step")
     return tuple(sorted(set(out), reverse=True))
 
 

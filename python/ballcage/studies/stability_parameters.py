@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from ballcage import _native
+from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene
 from ballcage.studies.common import resolve, toml_value
 
@@ -67,10 +68,10 @@ def drill_pipe_parameters(scene: SceneSource | None = None, values_per_parameter
     - ``damping``: ``materials.internal.normal.damping``, zero and 0.1–100 N·s/mm log-spaced.
     """
     if values_per_parameter < 2:
-        raise ValueError(f"values_per_parameter = {values_per_parameter}: must be at least 2")
+        raise InputError(f"values_per_parameter = {values_per_parameter}: must be at least 2")
     resolved = resolve(scene, ())
     if resolved.kind != "drill-pipe":
-        raise ValueError(f"scene kind = {resolved.kind!r}: the built-in stability parameters need a drill-pipe scene")
+        raise InputError(f"scene kind = {resolved.kind!r}: the built-in stability parameters need a drill-pipe scene")
     n = values_per_parameter
     law: dict[str, Any] = resolved.value("materials.internal.normal")
     exponent = float(law.get("exponent", 1.0))

@@ -10,6 +10,7 @@ from typing import Any, TypeAlias
 import pyarrow as pa
 
 from ballcage import _native
+from ballcage._native import InputError
 from ballcage.scene import SceneSource, load_scene
 from ballcage.studies.common import (
     Say,
@@ -71,9 +72,9 @@ def stability(
     """
     names = check_integrators(integrators if integrators is not None else available_integrators(), "integrators")
     if values_per_parameter < 2:
-        raise ValueError(f"values_per_parameter = {values_per_parameter}: must be at least 2")
+        raise InputError(f"values_per_parameter = {values_per_parameter}: must be at least 2")
     if bisections < 0:
-        raise ValueError(f"bisections = {bisections}: must be zero or more")
+        raise InputError(f"bisections = {bisections}: must be zero or more")
     check_duration(duration)
     base = _base_scene(scene, overrides, duration)
     drill_pipe = is_drill_pipe(base)
@@ -116,13 +117,13 @@ def _chosen(
             chosen.append(builtin[p])
         elif drill_pipe or p in PARAMETER_NAMES:
             where = ", ".join(PARAMETER_NAMES) if drill_pipe else "a drill-pipe scene; give Parameter objects for a generic scene"
-            raise ValueError(f"parameters: {p!r} is not a built-in parameter ({where})")
+            raise InputError(f"parameters: {p!r} is not a built-in parameter ({where})")
         else:
-            raise ValueError(f"parameters: {p!r} is not a built-in parameter (they need a drill-pipe scene; give Parameter objects)")
+            raise InputError(f"parameters: {p!r} is not a built-in parameter (they need a drill-pipe scene; give Parameter objects)")
     if not chosen and not grid:
-        raise ValueError("parameters: name at least one (a generic scene needs Parameter objects)")
+        raise InputError("parameters: name at least one (a generic scene needs Parameter objects)")
     if grid and not drill_pipe:
-        raise ValueError("grid: the stiffness × speed map needs a drill-pipe scene")
+        raise InputError("grid: the stiffness × speed map needs a drill-pipe scene")
     return chosen
 
 

@@ -26,8 +26,9 @@ from ballcage import _native
 from ballcage._files import write_parquet, write_text
 from ballcage.run import Run, simulate
 from ballcage.studies.sweep_quantities import case_quantities
+from ballcage.studies.sweep_spec import partition_name
 
-__all__ = ["CaseTask", "read_record", "record_path", "run_case", "write_record"]
+__all__ = ["CaseTask", "read_case_run", "read_record", "record_path", "run_case", "scene_path", "write_record"]
 
 #: Name of every table file inside a case's partition directory.
 PART = "part.parquet"
@@ -80,10 +81,28 @@ def run_case(task: CaseTask) -> dict[str, Any]:
             record["quantities"] = case_quantities(run)
     except Exception as e:  # noqa: BLE001
         record["status"], record["error"] = "error", _join(error, f"after the run: {_describe(e)}")
-    write_text(scene.to_toml(units=True) if scene.kind == "drill-pipe" else scene.to_toml(), _scene_path(out, task))
+    path = scene_path(out, task.partition)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_text(scene.to_toml(units=True) if scene.kind == "drill-pipe" else scene.to_toml(), path)
     record["case_wall_time_s"] = time.perf_counter() - start
     write_record(out, record)
     return record
+
+
+def read_case_run(out: Path, index: int) -> Run:
+    """The run of finished case `index` of the sweep in `out`, read back from its record, tables and scene.
+
+    Raises `FileNotFoundError` when the case has no record (it has not finished).
+    """
+    import pyarrow.parquet as pq  # deferred: only readers pay for it
+
+    partition = partition_name(index)
+    record = read_record(out, partition)
+    if record is None:
+        raise FileNotFoundError(f"{record_path(out, partition)}: no record of case {index} (not finished)")
+    tables = {name: pq.read_table(table_path(out, name, partition)) for name in record.get("tables", [])}
+    scene_toml = scene_path(out, partition).read_text(encoding="utf-8")
+    return Run(tables, scene_toml, error=record.get("error"))
 
 
 def failed_record(task: CaseTask, error: BaseException) -> dict[str, Any]:
@@ -135,10 +154,9 @@ def _cost(run: Run) -> dict[str, Any]:
     }
 
 
-def _scene_path(out: Path, task: CaseTask) -> Path:
-    path = out / CASES / f"{task.partition}.scene.toml"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return path
+def scene_path(out: Path, partition: str) -> Path:
+    """Where the resolved scene of the case in `partition` lives: ``DIR/cases/case=NNNN.scene.toml``."""
+    return out / CASES / f"{partition}.scene.toml"
 
 
 def write_record(out: Path, record: dict[str, Any]) -> Path:

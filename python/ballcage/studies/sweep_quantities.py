@@ -5,8 +5,9 @@ angles, the ranges of motion, the most deformed joint and the peak cage and
 key forces are the ``ours`` column of `ballcage.paper.comparison`; the largest
 per-link mean tube force and the largest race force on a key are its sweep
 quantities (``tube_mean_max``, ``key_peak``); the per-link mean and peak tube
-forces are `ballcage._links.link_tube_forces`, all over the scene's summary
-window. A quantity a hinge model does not have (cages and keys of the ideal
+forces are `ballcage._links.link_tube_forces`. Means (tube forces,
+efficiency) are over the scene's summary window; peaks of key and cage
+forces are over the whole run, as in the comparison. A quantity a hinge model does not have (cages and keys of the ideal
 CV hinge) or a run too short for (Table 3's phases lie in the last
 revolution) is ``None`` (null in ``summary.parquet``).
 """

@@ -35,7 +35,7 @@ from ballcage.studies.sweep_plots import write_plots
 from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
-__all__ = ["SweepResult", "sweep"]
+__all__ = ["SweepResult", "connect", "pending_cases", "sweep"]
 
 
 @dataclass
@@ -90,6 +90,14 @@ def sweep(
     finally:
         bar.close()
     return _finish(loaded, records, folder, len(pending), len(done), plots)
+
+
+def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
+    """How many cases of the sweep `spec` are not yet finished in the folder `out` (all of them in a new folder)."""
+    loaded = load_sweep(spec)
+    folder = Path(out)
+    pending, _ = _split_finished([_task(loaded, c, folder) for c in loaded.cases()], folder, retry_failed=False)
+    return len(pending)
 
 
 def _task(spec: SweepSpec, case: Case, out: Path) -> CaseTask:
@@ -260,18 +268,21 @@ def describe(result: SweepResult) -> Iterable[str]:
     )
 
 
+def connect(scheduler: str) -> Any:
+    """A ``dask.distributed.Client`` of the scheduler at `scheduler` (``--scheduler``); raises `SweepError`."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise SweepError("--scheduler needs dask.distributed: pip install 'ballcage[dask]'") from None
+    try:
+        return Client(scheduler, timeout="20s")
+    except (OSError, TimeoutError) as e:
+        raise SweepError(f"--scheduler {scheduler}: cannot connect: {e}") from None
+
+
 def command(args: Any) -> int:
     """``ballcage sweep``: runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not."""
-    client = None
-    if args.scheduler:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise SweepError("--scheduler needs dask.distributed: pip install 'ballcage[dask]'") from None
-        try:
-            client = Client(args.scheduler, timeout="20s")
-        except (OSError, TimeoutError) as e:
-            raise SweepError(f"--scheduler {args.scheduler}: cannot connect: {e}") from None
+    client = connect(args.scheduler) if args.scheduler else None
     try:
         result = sweep(
             args.sweep,

@@ -40,7 +40,7 @@ from typing import Any, TypeAlias
 from ballcage import _native
 from ballcage.scene import default_scene_toml
 
-__all__ = ["DEFAULT_TABLES", "Case", "SweepError", "SweepSpec", "SweepSource", "load_sweep", "toml_value"]
+__all__ = ["DEFAULT_TABLES", "Case", "SweepError", "SweepSpec", "SweepSource", "load_sweep", "partition_name", "toml_value"]
 
 #: Tables a drill-pipe case records unless the sweep or its base scene says otherwise (no per-body tables).
 DEFAULT_TABLES: tuple[str, ...] = ("links", "hinges", "keys", "drive", "summary")
@@ -48,7 +48,7 @@ _SECTIONS = ("sweep", "set", "grid", "case")
 _SWEEP_KEYS = ("name", "base", "tables")
 
 
-class SweepError(ValueError):
+class SweepError(_native.Error, ValueError):
     """A sweep file or sweep output folder that cannot be used; the message names the field, value and reason."""
 
 
@@ -69,7 +69,7 @@ class Case:
     @property
     def partition(self) -> str:
         """The hive partition directory of the case, ``case=0003``."""
-        return f"case={self.index:04d}"
+        return partition_name(self.index)
 
     def label(self) -> str:
         return " ".join(f"{k}={_short(v)}" for k, v in self.values.items())
@@ -141,6 +141,11 @@ class SweepSpec:
             _native.Scene.from_toml(self.base_toml, overrides)
         except _native.SceneError as e:
             raise SweepError(f"{self.source}: {what}: {e}") from None
+
+
+def partition_name(index: int) -> str:
+    """The hive partition directory of case `index`: ``case=0003``."""
+    return f"case={index:04d}"
 
 
 SweepSource: TypeAlias = "str | os.PathLike[str] | Mapping[str, Any] | SweepSpec"

@@ -12,7 +12,7 @@ import pyarrow as pa
 from ballcage import _native
 from ballcage.studies.sweep_quantities import QUANTITIES, link_columns
 
-__all__ = ["WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
+__all__ = ["COST_COLUMNS", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
 
 #: Columns that measure wall time: the only ones two runs of the same sweep may differ in.
 WALL_TIME_COLUMNS: tuple[str, ...] = ("wall_time_s", "case_wall_time_s")
@@ -24,7 +24,7 @@ _HEAD: tuple[tuple[str, pa.DataType, str, str], ...] = (
      "error: any other failure"),
     ("error", pa.string(), "", "why the case did not finish (the error message); null when ok"),
 )
-_COST: tuple[tuple[str, pa.DataType, str, str], ...] = (
+COST_COLUMNS: tuple[tuple[str, pa.DataType, str, str], ...] = (
     ("steps", pa.int64(), "", "integrator steps taken (ballcage.steps)"),
     ("simulated_time_s", pa.float64(), "s", "simulated time reached: steps x dt"),
     ("wall_time_s", pa.float64(), "s", "wall time of the simulation alone (ballcage.wall_time_s)"),
@@ -73,7 +73,7 @@ def summary_table(
         add(key, [r.get("parameters", {}).get(key) for r in rows], None, units.get(key, ""), f"scene key {key} (swept)")
     for name, (unit, description) in _quantity_columns(rows).items():
         add(name, [r.get("quantities", {}).get(name) for r in rows], pa.float64(), unit, description)
-    for name, kind, unit, description in _COST:
+    for name, kind, unit, description in COST_COLUMNS:
         add(name, [r.get(name) for r in rows], kind, unit, description)
     schema = pa.schema(fields)
     file_meta = dict(meta)

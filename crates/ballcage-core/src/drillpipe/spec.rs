@@ -399,6 +399,7 @@ impl Default for DrillPipeSpec {
                 newton: NewtonSpec::default(),
                 divergence: DivergenceSpec::default(),
                 threads: 1,
+                max_steps: crate::scene::default_max_steps(),
             },
             world: GravitySpec::default(),
             borehole: BoreholeSpec::default(),
@@ -487,7 +488,9 @@ impl DrillPipeSpec {
         crate::scene::to_toml_text(self)
     }
 
-    /// Checks every section; the first problem found is returned with its path.
+    /// Checks every section; the first problem of each independent section
+    /// is returned with its path, the first of them in the error and the
+    /// others in its `more`.
     pub fn validate(&self) -> Result<(), SceneError> {
         if self.kind != KIND {
             return Err(SceneError::new(
@@ -496,14 +499,18 @@ impl DrillPipeSpec {
                 format!("a drill-pipe scene has kind = \"{KIND}\""),
             ));
         }
-        self.borehole.validate()?;
-        self.pipe.validate(&self.borehole)?;
-        non_negative("drive.ramp", self.drive.ramp)?;
-        finite("drive.speed_rpm", self.drive.speed_rpm)?;
-        finite("load.resisting_moment", self.load.resisting_moment)?;
-        non_negative("load.ramp", self.load.ramp)?;
-        finite("world.gravity", self.world.gravity)?;
-        self.record.validate_tables()
+        SceneError::all([
+            // the pipe is checked against the borehole: only once the borehole is valid
+            self.borehole
+                .validate()
+                .and_then(|()| self.pipe.validate(&self.borehole)),
+            non_negative("drive.ramp", self.drive.ramp),
+            finite("drive.speed_rpm", self.drive.speed_rpm),
+            finite("load.resisting_moment", self.load.resisting_moment),
+            non_negative("load.ramp", self.load.ramp),
+            finite("world.gravity", self.world.gravity),
+            self.record.validate_tables(self.simulation.duration),
+        ])
     }
 }
 
@@ -625,6 +632,10 @@ impl BallKeySpec {
             positive(&format!("pipe.ball_keys.{name}"), v)?;
         }
         non_negative("pipe.ball_keys.flank_clearance", self.flank_clearance)?;
+        for (k, v) in self.cage_inertia.iter().enumerate() {
+            positive(&format!("pipe.ball_keys.cage_inertia[{k}]"), *v)?;
+        }
+        self.validate_keys_in_place()?;
         if self.groove_radius <= self.ball_radius + self.flank_clearance {
             return Err(SceneError::new(
                 "pipe.ball_keys.groove_radius",
@@ -660,6 +671,32 @@ impl BallKeySpec {
                     "must be shorter than the cage's inner diameter {} m, or the cage has no end openings",
                     2.0 * self.cage_inner_radius
                 ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The keys sit in the cage's wall and meet their races at less than 90°.
+    fn validate_keys_in_place(&self) -> Result<(), SceneError> {
+        let (low, high) = (
+            self.cage_inner_radius - self.ball_radius,
+            self.cage_outer_radius + self.ball_radius,
+        );
+        if !(self.pitch_radius > low && self.pitch_radius < high) {
+            return Err(SceneError::new(
+                "pipe.ball_keys.pitch_radius",
+                self.pitch_radius,
+                format!(
+                    "must put the keys through the cage's wall: between cage_inner_radius − ball_radius = {low} \
+                     and cage_outer_radius + ball_radius = {high} m"
+                ),
+            ));
+        }
+        if self.contact_angle_deg >= 90.0 {
+            return Err(SceneError::new(
+                "pipe.ball_keys.contact_angle_deg",
+                self.contact_angle_deg,
+                "must be below 90 (the angle between the race's contact normal and the radial direction)",
             ));
         }
         Ok(())

@@ -17,10 +17,10 @@ struct PairStats {
     frames: u64,
     normal_peak: f64,
     normal_sum: f64,
-    normal_sumsq: f64,
+    normal_squares: SumOfSquares,
     tangential_peak: f64,
     tangential_sum: f64,
-    tangential_sumsq: f64,
+    tangential_squares: SumOfSquares,
 }
 
 impl PairStats {
@@ -28,10 +28,39 @@ impl PairStats {
         self.frames += 1;
         self.normal_peak = self.normal_peak.max(n);
         self.normal_sum += n;
-        self.normal_sumsq += n * n;
+        self.normal_squares.add(n);
         self.tangential_peak = self.tangential_peak.max(t);
         self.tangential_sum += t;
-        self.tangential_sumsq += t * t;
+        self.tangential_squares.add(t);
+    }
+}
+
+/// Σx² kept as `scale`²·`ssq` (as LAPACK's dnrm2), so that forces above
+/// 1e154 N, whose squares overflow f64, still give a finite RMS (found by
+/// fuzzing).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct SumOfSquares {
+    scale: f64,
+    ssq: f64,
+}
+
+impl SumOfSquares {
+    fn add(&mut self, x: f64) {
+        let a = x.abs();
+        if a == 0.0 || a.is_nan() {
+            return;
+        }
+        if a > self.scale {
+            self.ssq = 1.0 + self.ssq * (self.scale / a) * (self.scale / a);
+            self.scale = a;
+        } else {
+            self.ssq += (a / self.scale) * (a / self.scale);
+        }
+    }
+
+    /// √(Σx² / n).
+    fn rms(&self, n: f64) -> f64 {
+        self.scale * (self.ssq / n).sqrt()
     }
 }
 
@@ -144,10 +173,10 @@ impl Recorder {
                     Cell::U64(s.frames),
                     Cell::F64(s.normal_peak),
                     Cell::F64(s.normal_sum / f),
-                    Cell::F64((s.normal_sumsq / f).sqrt()),
+                    Cell::F64(s.normal_squares.rms(f)),
                     Cell::F64(s.tangential_peak),
                     Cell::F64(s.tangential_sum / f),
-                    Cell::F64((s.tangential_sumsq / f).sqrt()),
+                    Cell::F64(s.tangential_squares.rms(f)),
                 ]);
             }
         }
@@ -232,4 +261,23 @@ fn energy(
         Cell::F64(e.potential_contact),
         Cell::F64(e.total()),
     ]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SumOfSquares;
+
+    #[test]
+    fn rms_by_hand_and_beyond_the_square_overflow() {
+        let mut s = SumOfSquares::default();
+        for x in [3.0, 4.0, 0.0, -12.0] {
+            s.add(x);
+        }
+        // (9 + 16 + 0 + 144) / 4 = 42.25
+        assert!((s.rms(4.0) - 6.5).abs() < 1e-12);
+        let mut big = SumOfSquares::default();
+        big.add(2e220);
+        big.add(2e220);
+        assert!((big.rms(2.0) / 2e220 - 1.0).abs() < 1e-12);
+    }
 }

@@ -291,7 +291,8 @@ impl BodySpec {
             return Some((m, i));
         }
         let (m1, i1) = self.shape.unit_density_mass_properties()?;
-        Some((m, i1.map(|x| x * m / m1)))
+        // a shape so small that its unit-density mass underflows has no inertia to scale
+        (m1 > 0.0 && m1.is_finite()).then(|| (m, i1.map(|x| x * m / m1)))
     }
 
     /// Checks every field; the first problem found is returned with its path.
@@ -389,13 +390,26 @@ impl BodySpec {
                     "missing: a moving body needs `mass` or `density`",
                 ));
             }
-            if self.mass_properties().is_none() {
+            let Some((mass, inertia)) = self.mass_properties() else {
                 return Err(SceneError::new(
                     format!("{path}.inertia"),
                     "",
                     format!(
-                        "missing: a {} has no volume to derive inertia from",
+                        "missing: a {} has no volume to derive inertia from (or one too small to compute)",
                         self.shape.kind_name()
+                    ),
+                ));
+            };
+            if !(mass > 0.0
+                && mass.is_finite()
+                && inertia.iter().all(|i| *i > 0.0 && i.is_finite()))
+            {
+                return Err(SceneError::new(
+                    format!("{path}.shape"),
+                    "",
+                    format!(
+                        "gives mass {mass:e} kg and inertia {inertia:?} kg·m²: not positive and finite (a shape \
+                         too small or too large for its mass or density); give `inertia` or resize it"
                     ),
                 ));
             }
@@ -423,6 +437,23 @@ impl BodySpec {
                 format!("{path}.spin_axis"),
                 format!("{:?}", self.spin_axis.unwrap_or_default()),
                 "only `kinematic-spin` and `spin` bodies take a spin axis",
+            )),
+            // NaN != 0 too: a stray value is refused, not kept in the scene unused
+            _ if self.spin_speed != 0.0 || self.spin_ramp != 0.0 => Err(SceneError::new(
+                format!(
+                    "{path}.{}",
+                    if self.spin_speed != 0.0 {
+                        "spin_speed"
+                    } else {
+                        "spin_ramp"
+                    }
+                ),
+                if self.spin_speed != 0.0 {
+                    self.spin_speed
+                } else {
+                    self.spin_ramp
+                },
+                "only `kinematic-spin` and `spin` bodies take a spin speed and ramp",
             )),
             _ => Ok(()),
         }

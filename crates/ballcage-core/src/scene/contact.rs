@@ -246,6 +246,16 @@ impl FrictionLawSpec {
                         format!("must exceed v_static = {v_static}"),
                     ));
                 }
+                if mu_dynamic > mu_static {
+                    return Err(SceneError::new(
+                        format!("{path}.mu_dynamic"),
+                        mu_dynamic,
+                        format!(
+                            "must not exceed mu_static = {mu_static} (the Adams law falls from static to \
+                             dynamic friction as the slip grows)"
+                        ),
+                    ));
+                }
                 Ok(())
             }
             Self::Tanh { mu, v_ref, .. } => {

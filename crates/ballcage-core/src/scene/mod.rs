@@ -12,6 +12,7 @@ mod contact;
 mod joint;
 mod load;
 mod overrides;
+mod suggest;
 
 pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
 pub use contact::{ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
@@ -238,10 +239,20 @@ pub struct SimulationSpec {
     /// bitwise identical for any count. Default 1; 0 takes one per core.
     #[serde(default = "one_thread")]
     pub threads: u32,
+    /// Most integrator steps a run may take [–]: a scene whose duration / dt
+    /// exceeds it is refused before it starts, with the count (a 1 ns step,
+    /// a typo in the duration). Raise it to run longer. Default 1e8.
+    #[serde(default = "default_max_steps")]
+    pub max_steps: u64,
 }
 
 fn one_thread() -> u32 {
     1
+}
+
+/// `simulation.max_steps` unless a scene sets it: 1e8 steps, about a day of the paper's scene at 1 ms a step.
+pub(crate) fn default_max_steps() -> u64 {
+    100_000_000
 }
 
 impl SimulationSpec {
@@ -255,6 +266,25 @@ impl SimulationSpec {
                 "simulation.dt",
                 self.dt,
                 format!("step longer than the duration {} s", self.duration),
+            ));
+        }
+        let steps = (self.duration / self.dt).ceil();
+        if self.max_steps == 0 {
+            return Err(SceneError::new(
+                "simulation.max_steps",
+                0,
+                "must be at least 1",
+            ));
+        }
+        if steps > self.max_steps as f64 {
+            return Err(SceneError::new(
+                "simulation.dt",
+                self.dt,
+                format!(
+                    "{steps:.3e} steps for simulation.duration = {} s, more than simulation.max_steps = {:.3e}; \
+                     raise simulation.max_steps to run this long",
+                    self.duration, self.max_steps as f64
+                ),
             ));
         }
         if whole_multiple(self.output_interval, self.dt).is_none() {
@@ -370,9 +400,9 @@ pub struct RecordSpec<T: TableChoice = TableKind> {
 }
 
 impl<T: TableChoice> RecordSpec<T> {
-    /// Checks the table list and the summary window (not the names, which
-    /// need the scene: [`Scene::validate`]).
-    pub fn validate_tables(&self) -> Result<(), SceneError> {
+    /// Checks the table list and the summary window against the run's
+    /// `duration` [s] (not the names, which need the scene: [`Scene::validate`]).
+    pub fn validate_tables(&self, duration: f64) -> Result<(), SceneError> {
         for (i, t) in self.tables.iter().enumerate() {
             if self.tables[..i].contains(t) {
                 return Err(SceneError::new(
@@ -382,14 +412,14 @@ impl<T: TableChoice> RecordSpec<T> {
                 ));
             }
         }
-        validate_window("record.summary_window", &self.summary_window)
+        validate_window("record.summary_window", &self.summary_window, duration)
     }
 }
 
 impl RecordSpec {
     /// Checks the tables, the summary window and the recorded names.
     fn validate(&self, scene: &Scene) -> Result<(), SceneError> {
-        self.validate_tables()?;
+        self.validate_tables(scene.simulation.duration)?;
         for (i, n) in self.bodies.iter().enumerate() {
             scene.body_id(&format!("record.bodies[{i}]"), n)?;
         }
@@ -408,7 +438,7 @@ impl RecordSpec {
 }
 
 /// Checks a time window `[start, end]` [s]; empty means the whole run.
-fn validate_window(path: &str, w: &[f64]) -> Result<(), SceneError> {
+fn validate_window(path: &str, w: &[f64], duration: f64) -> Result<(), SceneError> {
     if w.is_empty() {
         return Ok(());
     }
@@ -426,6 +456,16 @@ fn validate_window(path: &str, w: &[f64]) -> Result<(), SceneError> {
             format!("{path}[1]"),
             w[1],
             format!("must exceed the start {} s", w[0]),
+        ));
+    }
+    // the run's last frame is at `duration`; allow its rounding
+    if w[1] > duration * (1.0 + 1e-9) {
+        return Err(SceneError::new(
+            format!("{path}[1]"),
+            w[1],
+            format!(
+                "must not exceed simulation.duration = {duration} s (the window would reach past the run)"
+            ),
         ));
     }
     Ok(())
@@ -500,12 +540,16 @@ impl Scene {
         self.bodies.iter().position(|b| b.name == name)
     }
 
-    /// Checks every value; the first problem found is returned with its path.
+    /// Checks every value; the first problem of each independent section
+    /// (each body, then the pairs, loads and joints once the bodies are
+    /// valid) is returned with its path, the others in the error's `more`.
     pub fn validate(&self) -> Result<(), SceneError> {
-        self.simulation.validate()?;
-        finite_vec("world.gravity", &self.world.gravity)?;
-        self.validate_parts()?;
-        self.record.validate(self)
+        SceneError::all([
+            self.simulation.validate(),
+            finite_vec("world.gravity", &self.world.gravity),
+            self.validate_parts()
+                .and_then(|()| self.record.validate(self)),
+        ])
     }
 
     /// Bodies, contacts, loads and joints.
@@ -517,7 +561,7 @@ impl Scene {
                 "a scene needs at least one body",
             ));
         }
-        for (i, b) in self.bodies.iter().enumerate() {
+        SceneError::all(self.bodies.iter().enumerate().map(|(i, b)| {
             b.validate(&format!("bodies[{i}]"))?;
             if self.bodies[..i].iter().any(|o| o.name == b.name) {
                 return Err(SceneError::new(
@@ -526,7 +570,8 @@ impl Scene {
                     "duplicate body name",
                 ));
             }
-        }
+            Ok(())
+        }))?;
         for (i, c) in self.contacts.iter().enumerate() {
             c.validate(&format!("contacts[{i}]"), self)?;
         }
@@ -592,29 +637,94 @@ pub(crate) fn merge(base: &mut toml::Value, over: toml::Value) {
     }
 }
 
+/// Most errors one deserialization reports (`deserialize_with_path`).
+const MAX_ERRORS: usize = 20;
+
 /// Deserializes with the path of the offending field in the error.
+///
+/// After an unknown key or a value of the wrong type, the key is taken out
+/// and the document read again, so one error lists every such problem (up
+/// to `MAX_ERRORS`): the first in the error, the others in `more`.
 pub(crate) fn deserialize_with_path<T: serde::de::DeserializeOwned>(
     root: toml::Value,
 ) -> Result<T, SceneError> {
-    serde_path_to_error::deserialize(root).map_err(|e| {
-        let mut path = e.path().to_string();
-        if path == "." {
-            path.clear();
+    let mut value = root;
+    let mut errors: Vec<SceneError> = Vec::new();
+    let mut removed: Vec<String> = Vec::new();
+    loop {
+        let error = match serde_path_to_error::deserialize::<_, T>(value.clone()) {
+            Ok(parsed) if errors.is_empty() => return Ok(parsed),
+            Ok(_) => break,
+            Err(e) => path_error(e),
+        };
+        if removed.contains(&error.path) {
+            break; // a key taken out after an error of its own is missing now: not another error
         }
-        let reason = plain_types(&first_line(&e.into_inner().to_string()));
-        // serde reports a missing field at its parent: name the field itself.
-        if let Some(field) = reason
-            .strip_prefix("missing field `")
-            .and_then(|r| r.split('`').next())
-        {
-            path = if path.is_empty() {
-                field.to_string()
-            } else {
-                format!("{path}.{field}")
+        let retry = errors.len() + 1 < MAX_ERRORS
+            && !error.reason.starts_with("missing field")
+            && remove_key(&mut value, &error.path);
+        removed.push(error.path.clone());
+        errors.push(error);
+        if !retry {
+            break;
+        }
+    }
+    Err(SceneError::combine(errors).unwrap_or_else(|| SceneError::new("", "", "invalid scene")))
+}
+
+/// A serde error with the dotted path of the offending field.
+fn path_error(e: serde_path_to_error::Error<toml::de::Error>) -> SceneError {
+    let mut path = e.path().to_string();
+    if path == "." {
+        path.clear();
+    }
+    let reason = suggest::with_suggestion(plain_types(&first_line(&e.into_inner().to_string())));
+    // serde reports a missing field at its parent: name the field itself.
+    if let Some(field) = reason
+        .strip_prefix("missing field `")
+        .and_then(|r| r.split('`').next())
+    {
+        path = if path.is_empty() {
+            field.to_string()
+        } else {
+            format!("{path}.{field}")
+        };
+    }
+    SceneError::new(path, "", reason)
+}
+
+/// Takes the table key at the dotted `path` (`a.b[2].c`) out of `root`;
+/// `false` when the path does not end in a key of a table (an array item is
+/// never removed: the items after it would change their indices).
+fn remove_key(root: &mut toml::Value, path: &str) -> bool {
+    let mut parts: Vec<&str> = path.split('.').collect();
+    let Some(last) = parts.pop() else {
+        return false;
+    };
+    if last.is_empty() || last.contains('[') {
+        return false;
+    }
+    let mut node = root;
+    for part in parts {
+        let (key, indices) = part
+            .split_once('[')
+            .map_or((part, ""), |(k, rest)| (k, rest));
+        let Some(next) = node.get_mut(key) else {
+            return false;
+        };
+        node = next;
+        for index in indices.split('[').filter(|s| !s.is_empty()) {
+            let Some(i) = index.trim_end_matches(']').parse::<usize>().ok() else {
+                return false;
             };
+            let Some(next) = node.get_mut(i) else {
+                return false;
+            };
+            node = next;
         }
-        SceneError::new(path, "", reason)
-    })
+    }
+    node.as_table_mut()
+        .is_some_and(|table| table.remove(last).is_some())
 }
 
 /// Parses TOML text into a table. A syntax error names no field (`path`

@@ -1,0 +1,108 @@
+"""Figures 16–17 of the paper from the section-4 sweep: tube and key forces along the chain, one line per case.
+
+Each figure has two panels over the summary window of every case:
+
+- left: each link's mean tube normal force (``links.tube_normal``) against
+  the link's mean inclination (``links.inclination_deg``, the paper's "well
+  slope angle");
+- right: the largest race normal force on any key of each hinge
+  (max of ``keys.inner_normal`` and ``keys.outer_normal``) against the hinge
+  number (0: upper connector / link 1), as the paper's peak ball-key force.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ballcage._files import write_png
+from ballcage._links import WINDOW_SLACK, link_tube_forces, summary_window
+from ballcage._plot import figure, no_data, series_styles
+from ballcage.run import Run
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+__all__ = ["SECTION4_FIGURES", "hinge_key_peaks", "link_inclinations", "write_section4_figures"]
+
+#: Figure files (without ``.png``).
+SECTION4_FIGURES: tuple[str, ...] = ("fig16_curvature", "fig17_speed")
+
+
+def write_section4_figures(
+    curvature: Mapping[float, Run], speed: Mapping[float, Run], out_dir: str | os.PathLike[str]
+) -> dict[str, Path]:
+    """Writes ``fig16_curvature.png`` (runs by R [m]) and ``fig17_speed.png`` (runs by rpm); returns the paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    fig16 = _figure({f"R = {r:g} m": run for r, run in sorted(curvature.items())},
+                    "Fig. 16: contact forces along the chain for different borehole curvature radii (100 rpm)")
+    fig17 = _figure({f"{s:g} rpm": run for s, run in sorted(speed.items())},
+                    "Fig. 17: contact forces along the chain for different drive speeds (R = 1.5 m)")
+    return {
+        "fig16_curvature": write_png(fig16, out / "fig16_curvature.png"),
+        "fig17_speed": write_png(fig17, out / "fig17_speed.png"),
+    }
+
+
+def link_inclinations(run: Run) -> dict[int, float]:
+    """Each link's mean inclination [deg] over the summary window (``links.inclination_deg``)."""
+    links = run.tables.get("links")
+    if links is None or links.num_rows == 0:
+        return {}
+    inside = _inside(run, links.column("t").to_numpy())
+    link = links.column("link").to_numpy()
+    incl = links.column("inclination_deg").to_numpy()
+    return {int(k): float(incl[inside & (link == k)].mean()) for k in np.unique(link) if (inside & (link == k)).any()}
+
+
+def hinge_key_peaks(run: Run) -> dict[int, float]:
+    """Each hinge's largest race normal force on one key [N] over the summary window; empty without keys."""
+    keys = run.tables.get("keys")
+    if keys is None or keys.num_rows == 0:
+        return {}
+    inside = _inside(run, keys.column("t").to_numpy())
+    hinge = keys.column("hinge").to_numpy()
+    force = np.maximum(keys.column("inner_normal").to_numpy(), keys.column("outer_normal").to_numpy())
+    return {int(h): float(force[inside & (hinge == h)].max()) for h in np.unique(hinge) if (inside & (hinge == h)).any()}
+
+
+def _inside(run: Run, t: np.ndarray) -> np.ndarray:
+    start, end = summary_window(run.scene)
+    return (t >= start - WINDOW_SLACK) & (t <= end + WINDOW_SLACK)
+
+
+def _figure(runs: Mapping[str, Run], title: str) -> Figure:
+    fig = figure(figsize=(12, 4.8))
+    tube, keys = fig.subplots(1, 2)
+    styles = series_styles(len(runs))
+    for style, (label, run) in zip(styles, runs.items(), strict=True):
+        _tube_line(tube, run, label, style)
+        peaks = hinge_key_peaks(run)
+        if peaks:
+            keys.plot(list(peaks), [v / 1e3 for v in peaks.values()], label=label, **style)
+    for ax, what in ((tube, "no links table"), (keys, "no ball keys (pipe.hinge is not ball-keys)")):
+        if ax.lines:
+            ax.legend(fontsize=8)
+        else:
+            no_data(ax, what if runs else "no finished case")
+    tube.set(xlabel="link's mean inclination [deg]", ylabel="mean tube normal force per link [N]",
+             title="Link–tube contact (summary window)")
+    keys.set(xlabel="hinge [-] (0: upper connector / link 1)", ylabel="peak race normal force on one key [kN]",
+             title="Ball keys (summary window)")
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def _tube_line(ax: Axes, run: Run, label: str, style: dict[str, object]) -> None:
+    tube = link_tube_forces(run)
+    angles = link_inclinations(run)
+    if tube is None or not angles:
+        return
+    links = sorted(k for k in tube.normal_mean if k in angles)
+    ax.plot([angles[k] for k in links], [tube.normal_mean[k] for k in links], label=label, **style)  # type: ignore[arg-type]

@@ -1,0 +1,548 @@
+"""The design chart (issue 13): forces over curvature radius × joint length, and where the chain fits.
+
+For one guide tube (inner diameter D) and one joint outer diameter d, every
+cell of the grid curvature radius R × joint length L (``pipe.pitch``) is
+checked before anything runs, by the scene validator of the Rust core (the
+check ``ballcage run`` makes), which refuses a cell that breaks
+
+- eq. (9) of Zhu et al. 2023: a rigid joint L long fits the tube bent to R
+  only if L ≤ 2·√(2(D − d)(R + d/2)) (`ballcage.sizing.longest_joint`), or
+- the hinge's articulation limit β_max (`ballcage.Scene.articulation_limit_deg`):
+  placed on the arc each hinge bends 2·asin(L / 2R), so R ≥ L / (2·sin(β_max / 2))
+  (`ballcage.sizing.smallest_curvature_radius_for_bend`).
+
+A refused cell is infeasible; its reason names the constraints it breaks
+(both may; the validator reports eq. (9) first) or, for any other refusal,
+the validator's message. The feasible cells run as one sweep
+(`ballcage.studies.sweep_run.sweep`: local threads or Dask; running the same
+chart into the same folder resumes) with the hinge model, D, d, the duration
+and the summary window fixed. Written into ``out``::
+
+    design_chart.parquet   one row per cell: R, L, feasible, reason, the link's mass, the quantities
+    design_chart.png       heat maps over R × L (`ballcage.studies.design_chart_plot`)
+    summary.parquet, <table>/case=NNNN/part.parquet, cases/   the sweep's own files (docs/studies.md)
+
+**Link mass and inertia scale with L** (``scale_mass=True``, the default;
+`ReferenceLink.scaled`), from the base scene's link (the paper's: L₀ = 0.2 m,
+m₀ = 8.01 kg, I = [0.008306, 0.03085, 0.03085] kg·m², r₀ = 0.043 m): the
+mass m = m₀·L/L₀ (a link of the same cross-section), the axial inertia
+I_a = I_a0·m/m₀ (the same radial distribution), each transverse inertia as a
+solid cylinder's, m(3r₀² + L²)/12, scaled so that L = L₀ gives I_t0 exactly:
+I_t = I_t0·m(3r₀² + L²) / (m₀(3r₀² + L₀²)). The joint diameter d enters the
+fit and the tube contact, not the mass. With ``scale_mass=False`` every cell
+keeps the base scene's mass and inertia.
+
+Everything here is SI: metres, seconds, kilograms, newtons.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from ballcage import _native, sizing
+from ballcage._files import write_parquet, write_png
+from ballcage.scene import default_scene_toml
+from ballcage.studies.sweep_quantities import QUANTITIES
+from ballcage.studies.sweep_run import SweepResult, connect, pending_cases, sweep
+from ballcage.studies.sweep_spec import DEFAULT_TABLES, SweepError, SweepSpec, toml_value
+from ballcage.studies.sweep_summary import COST_COLUMNS
+
+__all__ = [
+    "DEFAULT_DURATION",
+    "DEFAULT_LENGTHS",
+    "DEFAULT_RADII",
+    "ChartError",
+    "DesignChart",
+    "ReferenceLink",
+    "chart_table",
+    "command",
+    "describe",
+    "design_chart",
+]
+
+#: Curvature radii [m] of the default chart.
+DEFAULT_RADII: tuple[float, ...] = (1.0, 1.5, 2.0, 3.0, 4.0)
+#: Joint lengths [m] of the default chart: for the paper's tube and joint the articulation limit cuts
+#: below L = 0.935 m (R = 3.60 m), eq. (9) above (it alone excludes R = 4 m, L = 1 m).
+DEFAULT_LENGTHS: tuple[float, ...] = (0.15, 0.2, 0.3, 0.4, 0.5, 1.0)
+#: Simulated duration [s] of every cell (the paper's 1.8 s: three revolutions at 100 rpm).
+DEFAULT_DURATION = 1.8
+#: Wall seconds per simulated second of one case on one core of this project's 2-core AMD EPYC
+#: (2026-11-23, the default chart's cells run two at a time), for the estimate printed before a chart runs.
+SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 11.4, "ideal-cv": 1.6}
+#: Constraint keys of `Cell.broken` and their labels.
+CONSTRAINTS: dict[str, str] = {"eq9": "eq. (9)", "articulation": "articulation limit"}
+
+RADIUS, LENGTH, MASS, INERTIA = "borehole.curvature_radius", "pipe.pitch", "pipe.link_mass", "pipe.link_inertia"
+#: Scene keys the chart sets itself, and the argument that sets each; an override of one is refused.
+_CHART_KEYS: dict[str, str] = {
+    RADIUS: "`radii`, --radius-mm",
+    LENGTH: "`lengths`, --length-mm",
+    "borehole.inner_diameter": "`tube_inner_diameter`, --tube-id",
+    "pipe.link_diameter": "`joint_diameter`, --joint-od",
+    "pipe.hinge": "`hinge`, --hinge",
+    "simulation.duration": "`duration`, --duration",
+    "record.summary_window": "`window`, --window",
+}
+#: Where the base scene is checked: a bend so wide that every joint of the grid fits it [m].
+_WIDE_RADIUS = 1e3
+#: The quantities the chart table copies from the sweep's summary, in order.
+QUANTITY_COLUMNS: tuple[str, ...] = (
+    "key_peak_n",
+    "tube_normal_mean_max_n",
+    "tube_normal_mean_all_n",
+    "tube_normal_peak_max_n",
+    "efficiency",
+    "wall_time_s",
+    "case_wall_time_s",
+)
+
+
+class ChartError(SweepError):
+    """Bad input to a design chart; the message names the argument, the value and the reason."""
+
+
+@dataclass(frozen=True)
+class ReferenceLink:
+    """The link masses scale from: length [m], mass [kg], inertia (axial, transverse, transverse) [kg·m²], radius [m]."""
+
+    length: float
+    mass: float
+    inertia: tuple[float, ...]
+    radius: float
+
+    @classmethod
+    def of(cls, scene: _native.Scene) -> ReferenceLink:
+        """The link of a drill-pipe scene: ``pipe.pitch``, ``pipe.link_mass``, ``pipe.link_inertia``, ``pipe.link_diameter`` / 2."""
+        inertia = tuple(float(v) for v in scene.value(INERTIA))
+        return cls(float(scene.value(LENGTH)), float(scene.value(MASS)), inertia, float(scene.value("pipe.link_diameter")) / 2)
+
+    def scaled(self, length: float) -> tuple[float, list[float]]:
+        """Mass [kg] and inertia [kg·m²] of a link `length` [m] long (the module docstring's rule).
+
+        m = m₀·L/L₀; axial I_a = I_a0·m/m₀; transverse I_t = I_t0·m(3r₀² + L²) / (m₀(3r₀² + L₀²)).
+        At L = L₀ it returns the reference's own values exactly.
+        """
+        ratio = length / self.length
+        shape = (3 * self.radius**2 + length**2) / (3 * self.radius**2 + self.length**2)
+        axial, *transverse = self.inertia
+        return self.mass * ratio, [axial * ratio, *(t * ratio * shape for t in transverse)]
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One cell of the chart: R [m], L [m], its scene overrides, the constraints it breaks, the validator's refusal."""
+
+    radius: float
+    length: float
+    values: dict[str, Any]
+    broken: tuple[str, ...]  # keys of CONSTRAINTS
+    refusal: str | None  # the SceneError message; None when the scene is valid
+
+    @property
+    def feasible(self) -> bool:
+        return self.refusal is None
+
+    @property
+    def reason(self) -> str | None:
+        """Why the cell is infeasible: ``"eq. (9)"``, ``"articulation limit"``, both, or the validator's message."""
+        if self.refusal is None:
+            return None
+        return " and ".join(CONSTRAINTS[b] for b in self.broken) or f"scene refused: {self.refusal}"
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """What every cell shares: the base scene text, the chart's fixed keys, the link and the limits."""
+
+    base_toml: str
+    fixed: dict[str, Any]
+    link: ReferenceLink
+    scale_mass: bool
+    limit_deg: float | None  # the hinge's articulation limit; None when nothing limits the bend
+    joints: int
+    overrides: tuple[str, ...]
+
+    @property
+    def tube(self) -> float:
+        return float(self.fixed["borehole.inner_diameter"])
+
+    @property
+    def joint(self) -> float:
+        return float(self.fixed["pipe.link_diameter"])
+
+
+@dataclass
+class DesignChart:
+    """What `design_chart` did: the chart table (one row per cell), the folder, the files, the sweep's result."""
+
+    table: pa.Table
+    out: Path
+    paths: dict[str, Path]
+    sweep: SweepResult | None
+    estimate_s: float | None  # the run time estimated before the sweep started [s]; None when nothing ran
+    elapsed_s: float  # wall time of the whole chart [s]
+
+    @property
+    def feasible(self) -> int:
+        return sum(1 for v in self.table.column("feasible").to_pylist() if v)
+
+    @property
+    def failed(self) -> int:
+        return self.sweep.failed if self.sweep is not None else 0
+
+
+def design_chart(
+    out: str | os.PathLike[str],
+    *,
+    radii: Sequence[float] = DEFAULT_RADII,
+    lengths: Sequence[float] = DEFAULT_LENGTHS,
+    tube_inner_diameter: float | None = None,
+    joint_diameter: float | None = None,
+    hinge: str = "ball-keys",
+    duration: float = DEFAULT_DURATION,
+    window: tuple[float, float] | None = None,
+    scale_mass: bool = True,
+    overrides: Sequence[str] = (),
+    workers: int | None = None,
+    client: Any = None,
+    progress: bool | None = None,
+) -> DesignChart:
+    """Maps the forces of the paper's drill pipe over curvature radius × joint length into the folder `out`.
+
+    `radii` and `lengths` [m] span the grid (R on x, L = ``pipe.pitch`` on y);
+    `tube_inner_diameter` D and `joint_diameter` d [m] default to the base
+    scene's (the paper's 0.116 and 0.086 m); `hinge` is ``"ball-keys"`` (the
+    paper's model) or ``"ideal-cv"``; `duration` [s] is simulated per cell and
+    the tube forces are averaged over `window` [s] (default the second half of
+    the run); `overrides` (``"key=value"``) change the embedded paper scene
+    except the keys the chart sets. `scale_mass`: see the module docstring.
+    `workers`, `client`, `progress`: as for `ballcage.studies.sweep_run.sweep`.
+    Writes ``design_chart.parquet`` and ``design_chart.png``; raises `ChartError`
+    (a `SweepError`) for bad input, before anything runs.
+    """
+    start = time.perf_counter()
+    setup = _setup(radii, lengths, tube_inner_diameter, joint_diameter, hinge, duration, window, scale_mass, overrides)
+    folder = Path(out)
+    if folder.exists() and not folder.is_dir():
+        raise ChartError(f"out = {str(folder)!r}: exists and is not a directory")
+    cells = _cells(setup, [float(r) for r in radii], [float(v) for v in lengths])
+    feasible = [c for c in cells if c.feasible]
+    say = (lambda text: print(f"ballcage: {text}", file=sys.stderr, flush=True)) if progress is not False else None
+    result, estimate = None, None
+    if feasible:
+        spec = _spec(setup, [c.values for c in feasible])
+        pending = pending_cases(spec, folder)
+        estimate = _estimate(pending, setup, workers, client)
+        if say:
+            say(_plan(cells, pending, estimate, setup))
+        result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress)
+    elif say:
+        say(_plan(cells, 0, None, setup))
+    folder.mkdir(parents=True, exist_ok=True)
+    table = chart_table(cells, result.summary if result is not None else None, setup)
+    paths = _write(table, folder)
+    return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start)
+
+
+def _setup(
+    radii: Sequence[float],
+    lengths: Sequence[float],
+    tube: float | None,
+    joint: float | None,
+    hinge: str,
+    duration: float,
+    window: tuple[float, float] | None,
+    scale_mass: bool,
+    overrides: Sequence[str],
+) -> _Setup:
+    """Checks the arguments and the base scene; raises `ChartError` naming the argument."""
+    for name, values in (("radii", radii), ("lengths", lengths)):
+        if len(values) == 0:
+            raise ChartError(f"{name}: empty; give at least one length in metres")
+        for v in values:
+            _positive(name, v, "m")
+    duration = _positive("duration", duration, "s")
+    start, end = (duration / 2, duration) if window is None else (float(window[0]), float(window[1]))
+    if not (0 <= start < end <= duration):
+        raise ChartError(f"window (--window) = ({start:g}, {end:g}) s: must satisfy 0 <= start < end <= duration = {duration:g} s")
+    for text in overrides:
+        key = text.partition("=")[0].strip()
+        if key in _CHART_KEYS:
+            raise ChartError(f"override {text!r}: the chart sets `{key}` itself (use {_CHART_KEYS[key]})")
+    base = _scene(default_scene_toml(), [*overrides, f"{RADIUS}={_WIDE_RADIUS!r}"], "overrides (--set)")
+    tube = _positive("tube_inner_diameter", tube, "m") if tube is not None else float(base.value("borehole.inner_diameter"))
+    joint = _positive("joint_diameter", joint, "m") if joint is not None else float(base.value("pipe.link_diameter"))
+    if joint >= tube:
+        raise ChartError(f"joint_diameter = {joint:g} m: not narrower than the tube, tube_inner_diameter = {tube:g} m")
+    fixed = {
+        "borehole.inner_diameter": tube,
+        "pipe.link_diameter": joint,
+        "pipe.hinge": hinge,
+        "simulation.duration": duration,
+        "record.summary_window": [start, end],
+    }
+    shared = _scene(base.to_toml(), [f"{k}={toml_value(v)}" for k, v in fixed.items()], "hinge, diameters or duration")
+    return _Setup(
+        base.to_toml(), fixed, ReferenceLink.of(base), scale_mass, shared.articulation_limit_deg(),
+        int(shared.value("pipe.joints")), tuple(overrides),
+    )
+
+
+def _positive(name: str, value: Any, unit: str) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ChartError(f"{name} = {value!r}: not a number in {unit}") from None
+    if not (math.isfinite(number) and number > 0):
+        raise ChartError(f"{name} = {value!r} {unit}: must be positive and finite")
+    return number
+
+
+def _scene(text: str, overrides: list[str], what: str) -> _native.Scene:
+    try:
+        scene = _native.Scene.from_toml(text, overrides)
+    except _native.SceneError as e:
+        raise ChartError(f"{what}: {e}") from None
+    if scene.kind != "drill-pipe":
+        raise ChartError(f"{what}: the chart needs a drill-pipe scene, not a {scene.kind} one")
+    return scene
+
+
+def _cells(setup: _Setup, radii: list[float], lengths: list[float]) -> list[Cell]:
+    """Every cell, L slowest then R, each validated by the scene validator exactly as its sweep case would run."""
+    spec = _spec(setup, [_values(setup, r, length) for length in lengths for r in radii])
+    cells = []
+    for case in spec.cases():
+        radius, length = case.values[RADIUS], case.values[LENGTH]
+        try:
+            _native.Scene.from_toml(spec.base_toml, list(case.overrides))
+            refusal = None
+        except _native.SceneError as e:
+            refusal = str(e)
+        cells.append(Cell(radius, length, case.values, _broken(setup, radius, length), refusal))
+    return cells
+
+
+def _values(setup: _Setup, radius: float, length: float) -> dict[str, Any]:
+    values: dict[str, Any] = {RADIUS: radius, LENGTH: length}
+    if setup.scale_mass:
+        values[MASS], values[INERTIA] = setup.link.scaled(length)
+    return values
+
+
+def _broken(setup: _Setup, radius: float, length: float) -> tuple[str, ...]:
+    """The constraints a cell breaks, by the closed forms (eq. (9); the articulation limit on chains of 2+ links)."""
+    out = []
+    if radius < setup.tube / 2 or length > sizing.longest_joint(radius, setup.tube, setup.joint):
+        out.append("eq9")
+    if setup.limit_deg is not None and setup.joints >= 2:
+        if radius < sizing.smallest_curvature_radius_for_bend(length, setup.limit_deg):
+            out.append("articulation")
+    return tuple(out)
+
+
+def _spec(setup: _Setup, cases: list[dict[str, Any]]) -> SweepSpec:
+    return SweepSpec(
+        name="design-chart",
+        base_toml=setup.base_toml,
+        tables=list(DEFAULT_TABLES),
+        fixed=dict(setup.fixed),
+        listed=cases,
+        source="design chart",
+    )
+
+
+def _estimate(pending: int, setup: _Setup, workers: int | None, client: Any) -> float:
+    """Seconds the pending cases should take: rounds of `workers` cases at the measured cost per simulated second."""
+    if client is not None:
+        info: dict[str, Any] = client.scheduler_info() if hasattr(client, "scheduler_info") else {}
+        parallel = max(1, len(info.get("workers", {})))
+    else:
+        parallel = workers or os.cpu_count() or 1
+    per_case = SECONDS_PER_SIMULATED_SECOND.get(str(setup.fixed["pipe.hinge"]), 10.0) * setup.fixed["simulation.duration"]
+    return math.ceil(pending / max(1, min(parallel, pending or 1))) * per_case
+
+
+def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: _Setup) -> str:
+    """The line printed before the chart runs: cells, why some are excluded, the estimate."""
+    excluded: dict[str, int] = {}
+    for c in cells:
+        if not c.feasible:
+            excluded[c.reason or ""] = excluded.get(c.reason or "", 0) + 1
+    why = "; ".join(f"{n} by {r}" for r, n in excluded.items()) or "none"
+    feasible = sum(c.feasible for c in cells)
+    line = f"design chart: {len(cells)} cells, {feasible} feasible, {len(cells) - feasible} excluded ({why})"
+    if estimate is None:
+        return line + "; nothing to run"
+    rate = SECONDS_PER_SIMULATED_SECOND.get(str(setup.fixed["pipe.hinge"]), 10.0)
+    return (
+        f"{line}; {pending} to run, {feasible - pending} already finished: about {_duration(estimate)} "
+        f"({setup.fixed['pipe.hinge']}, {setup.fixed['simulation.duration']:g} s each at ~{rate:g} s per simulated s "
+        "on one core of a 2-core AMD EPYC; a rough guide, cells differ by up to 5x)"
+    )
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{int(seconds // 60)} min {seconds % 60:.0f} s"
+
+
+def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: _Setup) -> pa.Table:
+    """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities.
+
+    Units and descriptions in each field's metadata (and as JSON in the file's), like ``summary.parquet``.
+    """
+    rows = {r["case"]: r for r in summary.to_pylist()} if summary is not None else {}
+    records, index = [], 0
+    for cell in cells:
+        row = None
+        if cell.feasible:  # the sweep's cases are the feasible cells, in order
+            row, index = rows.get(index), index + 1
+        records.append(_row(cell, row, setup))
+    if rows and len(rows) != sum(c.feasible for c in cells):
+        raise AssertionError("the sweep's cases are not the chart's feasible cells")
+    columns = _columns()
+    fields = [pa.field(n, t, metadata={"unit": u, "description": d}) for n, (t, u, d) in columns.items()]
+    arrays = [pa.array([r[n] for r in records], type=t) for n, (t, _, _) in columns.items()]
+    schema = pa.schema(fields).with_metadata(_file_metadata(fields, setup))
+    return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _row(cell: Cell, case: Mapping[str, Any] | None, setup: _Setup) -> dict[str, Any]:
+    mass, inertia = setup.link.scaled(cell.length) if setup.scale_mass else (setup.link.mass, list(setup.link.inertia))
+    ratio = cell.length / (2 * cell.radius)
+    fits = cell.radius >= setup.tube / 2
+    row: dict[str, Any] = {
+        RADIUS: cell.radius,
+        LENGTH: cell.length,
+        "feasible": cell.feasible,
+        "reason": cell.reason,
+        "refusal": cell.refusal,
+        "excluded_by_eq9": "eq9" in cell.broken,
+        "excluded_by_articulation": "articulation" in cell.broken,
+        "hinge_bend_deg": math.degrees(2 * math.asin(ratio)) if ratio <= 1 else None,
+        "longest_joint_m": sizing.longest_joint(cell.radius, setup.tube, setup.joint) if fits else None,
+        "tightest_radius_for_bend_m": (
+            sizing.smallest_curvature_radius_for_bend(cell.length, setup.limit_deg) if setup.limit_deg else None
+        ),
+        MASS: mass,
+        "link_inertia_axial": inertia[0],
+        "link_inertia_transverse": inertia[1],
+        "case": None if case is None else case["case"],
+        "case_id": None if case is None else case["case_id"],
+        "status": None if case is None else case["status"],
+    }
+    for name in QUANTITY_COLUMNS:
+        row[name] = None if case is None else case.get(name)
+    return row
+
+
+def _columns() -> dict[str, tuple[pa.DataType, str, str]]:
+    f64, text, flag = pa.float64(), pa.string(), pa.bool_()
+    columns: dict[str, tuple[pa.DataType, str, str]] = {
+        RADIUS: (f64, "m", "curvature radius R of the tube's centreline (x of the chart)"),
+        LENGTH: (f64, "m", "joint length L, the hinge pitch (y of the chart)"),
+        "feasible": (flag, "", "the scene validator accepts the cell (eq. (9) and the articulation limit hold)"),
+        "reason": (text, "", "why not: eq. (9), articulation limit, both, or the validator's message; null when feasible"),
+        "refusal": (text, "", "the scene validator's message for an infeasible cell; null when feasible"),
+        "excluded_by_eq9": (flag, "", "L > eq. (9)'s longest joint 2*sqrt(2(D - d)(R + d/2)), or R < D/2"),
+        "excluded_by_articulation": (flag, "", "R < L / (2 sin(beta_max / 2)): a placed hinge bends past its limit"),
+        "hinge_bend_deg": (f64, "deg", "bend of a hinge placed on the arc, 2 asin(L / 2R); null when L > 2R"),
+        "longest_joint_m": (f64, "m", "eq. (9): the longest joint that fits the tube at this R; null when R < D/2"),
+        "tightest_radius_for_bend_m": (f64, "m", "the tightest R the articulation limit allows at this L; null without one"),
+        MASS: (f64, "kg", "mass of each link (scaled with L unless scale_mass is off)"),
+        "link_inertia_axial": (f64, "kg m^2", "axial moment of inertia of each link"),
+        "link_inertia_transverse": (f64, "kg m^2", "transverse moment of inertia of each link"),
+        "case": (pa.int32(), "", "the sweep case of the cell (partition case=NNNN); null when infeasible"),
+        "case_id": (text, "", "the sweep case's id; null when infeasible"),
+        "status": (text, "", "ok, diverged or error (summary.parquet); null when infeasible"),
+    }
+    units = {name: (unit, description) for name, _, unit, description in COST_COLUMNS}
+    units.update(QUANTITIES)
+    for name in QUANTITY_COLUMNS:
+        unit, description = units[name]
+        columns[name] = (f64, unit, description + " (null when infeasible or not computed)")
+    return columns
+
+
+def _file_metadata(fields: list[pa.Field], setup: _Setup) -> dict[str, str]:
+    window = setup.fixed["record.summary_window"]
+    return {
+        "ballcage.version": _native.__version__,
+        "ballcage.chart_hinge": str(setup.fixed["pipe.hinge"]),
+        "ballcage.chart_tube_inner_diameter_m": repr(setup.tube),
+        "ballcage.chart_joint_diameter_m": repr(setup.joint),
+        "ballcage.chart_duration_s": repr(setup.fixed["simulation.duration"]),
+        "ballcage.chart_summary_window_s": json.dumps(window),
+        "ballcage.chart_articulation_limit_deg": json.dumps(setup.limit_deg),
+        "ballcage.chart_joints": str(setup.joints),
+        "ballcage.chart_mass_scaling": json.dumps(
+            {"on": setup.scale_mass, "reference_length_m": setup.link.length, "reference_mass_kg": setup.link.mass,
+             "reference_inertia_kg_m2": list(setup.link.inertia), "reference_radius_m": setup.link.radius}
+        ),
+        "ballcage.chart_overrides": json.dumps(list(setup.overrides)),
+        "ballcage.units": json.dumps({f.name: f.metadata[b"unit"].decode() for f in fields}),
+        "ballcage.descriptions": json.dumps({f.name: f.metadata[b"description"].decode() for f in fields}),
+    }
+
+
+def _write(table: pa.Table, out: Path) -> dict[str, Path]:
+    from ballcage.studies.design_chart_plot import chart_figure  # deferred: matplotlib
+
+    return {
+        "table": write_parquet(table, out / "design_chart.parquet"),
+        "figure": write_png(chart_figure(table), out / "design_chart.png"),
+    }
+
+
+def describe(chart: DesignChart) -> Iterable[str]:
+    """Lines the CLI prints after a chart: the files, the cells, the run time against the estimate."""
+    cells = chart.table.num_rows
+    yield f"wrote {chart.paths['figure']}  (design chart)"
+    yield f"wrote {chart.paths['table']}  ({cells} cells, {chart.feasible} feasible)"
+    if chart.sweep is not None:
+        yield f"wrote {chart.sweep.paths['summary']}  (the sweep of the feasible cells, {chart.sweep.summary.num_rows} cases)"
+        guess = f", estimated {_duration(chart.estimate_s)}" if chart.estimate_s is not None else ""
+        yield (
+            f"ballcage: {chart.sweep.ran} cases run, {chart.sweep.skipped} skipped (already finished), "
+            f"{chart.failed} not ok; {_duration(chart.elapsed_s)} in all{guess}"
+        )
+
+
+def command(args: Any, **inputs: Any) -> int:
+    """``ballcage chart`` after the CLI has checked and converted its options (`inputs`, SI, for `design_chart`).
+
+    Prints the estimate before and the files after; 0 when every feasible cell finished, 1 when some did not.
+    """
+    client = connect(args.scheduler) if args.scheduler else None
+    try:
+        chart = design_chart(
+            args.out, **inputs, overrides=args.overrides, workers=args.workers, client=client,
+            progress=False if args.quiet else None,
+        )
+    except KeyboardInterrupt:
+        print(f"ballcage: chart interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
+        raise
+    finally:
+        if client is not None:
+            client.close()
+    if not args.quiet:
+        for line in describe(chart):
+            print(line)
+    if chart.failed:
+        bad = [r for r in chart.table.to_pylist() if r["feasible"] and r["status"] != "ok"]
+        where = f"R = {bad[0][RADIUS]:g} m, L = {bad[0][LENGTH]:g} m: {bad[0]['status']}" if bad else "see summary.parquet"
+        print(f"ballcage: error: {chart.failed} feasible cells did not finish (first {where}); "
+              f"see {chart.out / 'summary.parquet'}", file=sys.stderr)
+        return 1
+    return 0
