@@ -12,6 +12,7 @@ echo "== cargo clippy"
 cargo clippy --workspace --all-targets -- -D warnings
 echo "== cargo test"
 cargo test --workspace
+FUZZ_SECONDS=30 bash scripts/fuzz-ci.sh  # cargo-fuzz targets of fuzz/ (stable, RUSTC_BOOTSTRAP=1): replays fuzz/regressions, then 30 s each
 echo "== pip install .[test] (release build of the wheel)"
 python3 -m pip install --quiet ".[test]"
 echo "== the test-panic build (tests/test_panic.py; never shipped)"

@@ -491,30 +491,47 @@ impl Dynamics {
 
     /// Kinetic, gravitational and elastic contact energy at `state`.
     pub fn energy(&mut self, model: &Model, state: &State) -> Energy {
-        let mut kinetic = 0.0;
-        let mut potential_gravity = 0.0;
-        for &i in &model.integrated {
-            let b = &model.bodies[i];
-            let w = state.omega[i];
-            kinetic += 0.5 * b.mass * state.vel[i].norm_squared()
-                + 0.5 * w.dot(&b.inertia.component_mul(&w));
-            potential_gravity -= b.mass * model.gravity.dot(&state.pos[i]);
-        }
-        let mut potential_contact = 0.0;
-        let mut points = std::mem::take(&mut self.points);
-        for pair in &model.pairs {
-            find_points(model, pair, state, &mut points);
-            potential_contact += points
-                .iter()
-                .map(|p| pair.normal.elastic_energy(p.depth))
-                .sum::<f64>();
-        }
-        self.points = points;
-        Energy {
-            kinetic,
-            potential_gravity,
-            potential_contact,
-        }
+        energy_of(model, state, &mut self.points)
+    }
+}
+
+/// The first contact pair whose elastic energy at `state` is not finite.
+pub fn pair_with_infinite_energy<'m>(model: &'m Model, state: &State) -> Option<&'m ContactPair> {
+    let mut points = Vec::new();
+    model.pairs.iter().find(|pair| {
+        find_points(model, pair, state, &mut points);
+        !points
+            .iter()
+            .map(|p| pair.normal.elastic_energy(p.depth))
+            .sum::<f64>()
+            .is_finite()
+    })
+}
+
+/// The energy of `state` (see [`Dynamics::energy`]), with `points` as the
+/// contact points' scratch buffer: no [`Dynamics`] (and no thread pool) needed.
+pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -> Energy {
+    let mut kinetic = 0.0;
+    let mut potential_gravity = 0.0;
+    for &i in &model.integrated {
+        let b = &model.bodies[i];
+        let w = state.omega[i];
+        kinetic +=
+            0.5 * b.mass * state.vel[i].norm_squared() + 0.5 * w.dot(&b.inertia.component_mul(&w));
+        potential_gravity -= b.mass * model.gravity.dot(&state.pos[i]);
+    }
+    let mut potential_contact = 0.0;
+    for pair in &model.pairs {
+        find_points(model, pair, state, points);
+        potential_contact += points
+            .iter()
+            .map(|p| pair.normal.elastic_energy(p.depth))
+            .sum::<f64>();
+    }
+    Energy {
+        kinetic,
+        potential_gravity,
+        potential_contact,
     }
 }
 

@@ -577,7 +577,7 @@ fn deepest_penetration(
 /// frame at t = 0 would hold infinities, and no step could follow. Names
 /// the first body or pair whose energy is not finite.
 pub(crate) fn initial_energy_is_finite(model: &Model, state: &State) -> Result<(), SceneError> {
-    let energy = Dynamics::new(model).energy(model, state);
+    let energy = crate::dynamics::energy_of(model, state, &mut Vec::new());
     if energy.total().is_finite() {
         return Ok(());
     }
@@ -593,7 +593,13 @@ pub(crate) fn initial_energy_is_finite(model: &Model, state: &State) -> Result<(
             "body `{}` (its mass, velocity or position)",
             model.bodies[i].name
         ),
-        None => "a contact pair's overlap (a body placed far inside another)".to_string(),
+        None => match crate::dynamics::pair_with_infinite_energy(model, state) {
+            Some(pair) => format!(
+                "the overlap of contact pair `{}` (a body placed far inside another)",
+                pair.name
+            ),
+            None => "a body's mass or position".to_string(),
+        },
     };
     Err(SceneError::new(
         "",

@@ -326,3 +326,33 @@ fn a_cage_inertia_and_a_pitch_radius_outside_the_cage_are_refused() {
     let e = pipe_error_of(&["pipe.ball_keys.pitch_radius=0.040"]);
     assert_eq!(e.path, "pipe.ball_keys.pitch_radius", "{e}");
 }
+
+#[test]
+fn thousands_of_threads_are_refused() {
+    // found by fuzzing: simulation.threads = 5000 started a 5000-thread pool per run
+    assert!(Scene::from_toml_str(GOOD, &["simulation.threads=256".into()]).is_ok());
+    let e = error_of(GOOD, &["simulation.threads=5000"]);
+    assert_eq!(e.path, "simulation.threads", "{e}");
+}
+
+#[test]
+fn a_curvature_radius_beyond_100_km_is_refused() {
+    // fuzz/regressions/huge-curvature-radius-infinite-depth.toml: 1e308 m overflowed the tube's geometry
+    let e = pipe_error_of(&["borehole.curvature_radius=1e308"]);
+    assert_eq!(e.path, "borehole.curvature_radius", "{e}");
+    let e = pipe_error_of(&["borehole.curvature_radius=1.1e5"]);
+    assert_eq!(e.path, "borehole.curvature_radius", "{e}");
+}
+
+#[test]
+fn a_start_with_an_overlap_whose_energy_overflows_names_the_pair() {
+    // fuzz/regressions/huge-overlap-infinite-contact-energy.toml: a 1e200 m ball sunk into the ground
+    let e = error_of(
+        GOOD,
+        &[
+            "bodies[1].shape.radius=1e200",
+            "bodies[1].inertia=[1.0, 1.0, 1.0]",
+        ],
+    );
+    assert!(e.reason.contains("the overlap of contact pair `"), "{e}");
+}

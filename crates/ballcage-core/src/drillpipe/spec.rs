@@ -514,9 +514,23 @@ impl DrillPipeSpec {
     }
 }
 
+/// Largest `borehole.curvature_radius` [m] accepted: 100 km, a bend no
+/// drill pipe notices over its length, with f64 still resolving 1e-11 of it.
+const MAX_CURVATURE_RADIUS: f64 = 1e5;
+
 impl BoreholeSpec {
     fn validate(&self) -> Result<(), SceneError> {
         positive("borehole.curvature_radius", self.curvature_radius)?;
+        if self.curvature_radius > MAX_CURVATURE_RADIUS {
+            return Err(SceneError::new(
+                "borehole.curvature_radius",
+                self.curvature_radius,
+                format!(
+                    "must be at most {MAX_CURVATURE_RADIUS:e} m: beyond that the bend's geometry loses the \
+                     micrometres contact needs (found by fuzzing: 1e308 m overflowed)"
+                ),
+            ));
+        }
         positive("borehole.build_angle_deg", self.build_angle_deg)?;
         if self.build_angle_deg > 180.0 {
             return Err(SceneError::new(

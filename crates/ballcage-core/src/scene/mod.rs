@@ -246,6 +246,10 @@ pub struct SimulationSpec {
     pub max_steps: u64,
 }
 
+/// Most threads `simulation.threads` may ask for: each simulation starts
+/// its own pool, and thousands of threads only thrash (found by fuzzing).
+const MAX_THREADS: u32 = 256;
+
 fn one_thread() -> u32 {
     1
 }
@@ -266,6 +270,13 @@ impl SimulationSpec {
                 "simulation.dt",
                 self.dt,
                 format!("step longer than the duration {} s", self.duration),
+            ));
+        }
+        if self.threads > MAX_THREADS {
+            return Err(SceneError::new(
+                "simulation.threads",
+                self.threads,
+                format!("must be at most {MAX_THREADS} (0 takes one per core)"),
             ));
         }
         let steps = (self.duration / self.dt).ceil();
