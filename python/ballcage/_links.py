@@ -16,7 +16,7 @@ import numpy as np
 from ballcage import _native
 from ballcage.run import Run
 
-__all__ = ["LinkTubeForces", "link_tube_forces", "summary_window"]
+__all__ = ["LinkTubeForces", "in_summary_window", "link_tube_forces", "summary_window"]
 
 #: Slack [s] on the window's ends, as the engine's summary table applies it.
 WINDOW_SLACK = 1e-12
@@ -42,6 +42,12 @@ def summary_window(scene: _native.Scene) -> tuple[float, float]:
     return 0.0, math.inf
 
 
+def in_summary_window(scene: _native.Scene, t: np.ndarray) -> np.ndarray:
+    """Which of the times `t` [s] lie in the scene's summary window (`summary_window`, with `WINDOW_SLACK`)."""
+    start, end = summary_window(scene)
+    return (t >= start - WINDOW_SLACK) & (t <= end + WINDOW_SLACK)
+
+
 def link_tube_forces(run: Run) -> LinkTubeForces | None:
     """Mean and peak link–tube forces [N] per link over the summary window; ``None`` without a ``links`` table."""
     links = run.tables.get("links")
@@ -49,7 +55,7 @@ def link_tube_forces(run: Run) -> LinkTubeForces | None:
         return None
     start, end = summary_window(run.scene)
     t = links.column("t").to_numpy()
-    inside = (t >= start - WINDOW_SLACK) & (t <= end + WINDOW_SLACK)
+    inside = in_summary_window(run.scene, t)
     link = links.column("link").to_numpy()
     normal = links.column("tube_normal").to_numpy()
     tangential = links.column("tube_tangential").to_numpy()

@@ -729,26 +729,23 @@ def _stability(args: argparse.Namespace) -> int:
 def _paper(args: argparse.Namespace) -> int:
     from ballcage.paper import run_paper  # deferred: imports matplotlib
 
-    from ballcage.studies.sweep_run import connect
+    from ballcage.studies.sweep_run import scheduler_client
     from ballcage.studies.sweep_spec import SweepError
 
     overrides = [_checked_override(o) for o in args.overrides]
     out = _checked_out(args.out)
     if (args.workers or args.scheduler) and not args.sweeps:
         raise UsageError(f"--{'workers' if args.workers else 'scheduler'}: only with --sweeps (it sets where the sweep runs)")
-    client = None
     try:
-        client = connect(args.scheduler) if args.scheduler else None
-        paths = run_paper(
-            out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None, workers=args.workers, client=client
-        )
+        with scheduler_client(args.scheduler) as client:
+            paths = run_paper(
+                out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None, workers=args.workers,
+                client=client,
+            )
     except _native.SceneError as e:
         raise UsageError(f"{DEFAULT_SCENE_NAME}: {e}") from e
     except SweepError as e:
         raise UsageError(str(e)) from e
-    finally:
-        if client is not None:
-            client.close()
     if not args.quiet:
         for name, path in paths.items():
             print(_paper_summary(name, path))

@@ -495,6 +495,14 @@ impl Dynamics {
     }
 }
 
+/// Body `i`'s kinetic and gravitational potential energy [J] at `state`.
+pub fn body_energy(model: &Model, state: &State, i: usize) -> (f64, f64) {
+    let (b, w) = (&model.bodies[i], state.omega[i]);
+    let kinetic =
+        0.5 * b.mass * state.vel[i].norm_squared() + 0.5 * w.dot(&b.inertia.component_mul(&w));
+    (kinetic, -b.mass * model.gravity.dot(&state.pos[i]))
+}
+
 /// The first contact pair whose elastic energy at `state` is not finite.
 pub fn pair_with_infinite_energy<'m>(model: &'m Model, state: &State) -> Option<&'m ContactPair> {
     let mut points = Vec::new();
@@ -514,11 +522,9 @@ pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -
     let mut kinetic = 0.0;
     let mut potential_gravity = 0.0;
     for &i in &model.integrated {
-        let b = &model.bodies[i];
-        let w = state.omega[i];
-        kinetic +=
-            0.5 * b.mass * state.vel[i].norm_squared() + 0.5 * w.dot(&b.inertia.component_mul(&w));
-        potential_gravity -= b.mass * model.gravity.dot(&state.pos[i]);
+        let (k, g) = body_energy(model, state, i);
+        kinetic += k;
+        potential_gravity += g;
     }
     let mut potential_contact = 0.0;
     for pair in &model.pairs {

@@ -582,10 +582,7 @@ pub(crate) fn initial_energy_is_finite(model: &Model, state: &State) -> Result<(
         return Ok(());
     }
     let body = model.integrated.iter().find(|&&i| {
-        let (b, w) = (&model.bodies[i], state.omega[i]);
-        let kinetic =
-            0.5 * b.mass * state.vel[i].norm_squared() + 0.5 * w.dot(&b.inertia.component_mul(&w));
-        let gravity = b.mass * model.gravity.dot(&state.pos[i]);
+        let (kinetic, gravity) = crate::dynamics::body_energy(model, state, i);
         !(kinetic.is_finite() && gravity.is_finite())
     });
     let culprit = match body {

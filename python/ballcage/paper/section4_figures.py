@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ballcage._files import write_png
-from ballcage._links import WINDOW_SLACK, link_tube_forces, summary_window
+from ballcage._links import in_summary_window, link_tube_forces
 from ballcage._plot import figure, no_data, series_styles
 from ballcage.run import Run
 
@@ -55,7 +55,7 @@ def link_inclinations(run: Run) -> dict[int, float]:
     links = run.tables.get("links")
     if links is None or links.num_rows == 0:
         return {}
-    inside = _inside(run, links.column("t").to_numpy())
+    inside = in_summary_window(run.scene, links.column("t").to_numpy())
     link = links.column("link").to_numpy()
     incl = links.column("inclination_deg").to_numpy()
     return {int(k): float(incl[inside & (link == k)].mean()) for k in np.unique(link) if (inside & (link == k)).any()}
@@ -66,15 +66,10 @@ def hinge_key_peaks(run: Run) -> dict[int, float]:
     keys = run.tables.get("keys")
     if keys is None or keys.num_rows == 0:
         return {}
-    inside = _inside(run, keys.column("t").to_numpy())
+    inside = in_summary_window(run.scene, keys.column("t").to_numpy())
     hinge = keys.column("hinge").to_numpy()
     force = np.maximum(keys.column("inner_normal").to_numpy(), keys.column("outer_normal").to_numpy())
     return {int(h): float(force[inside & (hinge == h)].max()) for h in np.unique(hinge) if (inside & (hinge == h)).any()}
-
-
-def _inside(run: Run, t: np.ndarray) -> np.ndarray:
-    start, end = summary_window(run.scene)
-    return (t >= start - WINDOW_SLACK) & (t <= end + WINDOW_SLACK)
 
 
 def _figure(runs: Mapping[str, Run], title: str) -> Figure:

@@ -53,7 +53,7 @@ from ballcage import _native, sizing
 from ballcage._files import write_parquet, write_png
 from ballcage.scene import default_scene_toml
 from ballcage.studies.sweep_quantities import QUANTITIES
-from ballcage.studies.sweep_run import SweepResult, connect, pending_cases, sweep
+from ballcage.studies.sweep_run import SweepResult, pending_cases, scheduler_client, sweep
 from ballcage.studies.sweep_spec import DEFAULT_TABLES, SweepError, SweepSpec, toml_value
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
@@ -524,18 +524,15 @@ def command(args: Any, **inputs: Any) -> int:
 
     Prints the estimate before and the files after; 0 when every feasible cell finished, 1 when some did not.
     """
-    client = connect(args.scheduler) if args.scheduler else None
     try:
-        chart = design_chart(
-            args.out, **inputs, overrides=args.overrides, workers=args.workers, client=client,
-            progress=False if args.quiet else None,
-        )
+        with scheduler_client(args.scheduler) as client:
+            chart = design_chart(
+                args.out, **inputs, overrides=args.overrides, workers=args.workers, client=client,
+                progress=False if args.quiet else None,
+            )
     except KeyboardInterrupt:
         print(f"ballcage: chart interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
         raise
-    finally:
-        if client is not None:
-            client.close()
     if not args.quiet:
         for line in describe(chart):
             print(line)

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ballcage._links import WINDOW_SLACK, link_tube_forces, summary_window
+from ballcage._links import in_summary_window, link_tube_forces
 from ballcage.run import Run
 
 __all__ = ["QUANTITIES", "case_quantities", "link_columns"]
@@ -105,9 +105,7 @@ def _efficiency(run: Run) -> float | None:
     drive = run.tables.get("drive")
     if drive is None or drive.num_rows == 0:
         return None
-    start, end = summary_window(run.scene)
-    t = drive.column("t").to_numpy()
-    inside = (t >= start - WINDOW_SLACK) & (t <= end + WINDOW_SLACK)
+    inside = in_summary_window(run.scene, drive.column("t").to_numpy())
     if not inside.any():
         return None
     p_in = float(np.mean(drive.column("input_power").to_numpy()[inside]))

@@ -20,7 +20,8 @@ import json
 import os
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,7 +36,7 @@ from ballcage.studies.sweep_plots import write_plots
 from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
-__all__ = ["SweepResult", "connect", "pending_cases", "sweep"]
+__all__ = ["SweepResult", "connect", "pending_cases", "scheduler_client", "sweep"]
 
 
 @dataclass
@@ -280,25 +281,33 @@ def connect(scheduler: str) -> Any:
         raise SweepError(f"--scheduler {scheduler}: cannot connect: {e}") from None
 
 
-def command(args: Any) -> int:
-    """``ballcage sweep``: runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not."""
-    client = connect(args.scheduler) if args.scheduler else None
+@contextmanager
+def scheduler_client(scheduler: str | None) -> Iterator[Any]:
+    """The ``--scheduler`` option as a context: a connected client (`connect`), or ``None`` without one; closed after."""
+    client = connect(scheduler) if scheduler else None
     try:
-        result = sweep(
-            args.sweep,
-            args.out,
-            client=client,
-            workers=args.workers,
-            retry_failed=args.retry_failed,
-            plots=not args.no_plots,
-            progress=False if args.quiet else None,
-        )
-    except KeyboardInterrupt:
-        print(f"ballcage: sweep interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
-        raise
+        yield client
     finally:
         if client is not None:
             client.close()
+
+
+def command(args: Any) -> int:
+    """``ballcage sweep``: runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not."""
+    try:
+        with scheduler_client(args.scheduler) as client:
+            result = sweep(
+                args.sweep,
+                args.out,
+                client=client,
+                workers=args.workers,
+                retry_failed=args.retry_failed,
+                plots=not args.no_plots,
+                progress=False if args.quiet else None,
+            )
+    except KeyboardInterrupt:
+        print(f"ballcage: sweep interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
+        raise
     if not args.quiet:
         for line in describe(result):
             print(line)
