@@ -109,6 +109,8 @@ CATALOGUE: tuple[Entry, ...] = (
     _set("summary window past the run", "record.summary_window=[0.0, 5.0]", "simulation.duration"),
     _set("record an unknown body", 'record.bodies=["nope"]', "record.bodies[0]"),
     _set("a table listed twice", 'record.tables=["links", "links"]', "listed twice"),
+    _set("tables over the memory budget", "record.max_bytes=1000000", "record.max_bytes", "frames", "contacts"),
+    _set("zero memory budget", "record.max_bytes=0", "record.max_bytes", "at least 1"),
     # several errors at once: all in the one line
     Entry("three errors in one scene", ("run", "--out", "{out}", "--set", "pipe.jionts=3", "--set",
                                         'simulation.dt="x"', "--set", "drive.speed_rpmm=5"),

@@ -111,9 +111,11 @@ class SceneBuilder:
         tables: Sequence[str] | None = None,
         bodies: Sequence[str] | None = None,
         contacts: Sequence[str] | None = None,
+        max_bytes: int | None = None,
     ) -> Self:
-        """What to record: table names, and optionally which bodies and contact pairs."""
-        given = {"tables": tables, "bodies": bodies, "contacts": contacts}
+        """What to record: table names, and optionally which bodies and contact
+        pairs, and the memory budget of the recorded tables `max_bytes` [B]."""
+        given = {"tables": tables, "bodies": bodies, "contacts": contacts, "max_bytes": max_bytes}
         self._scene.setdefault("record", {}).update({k: _plain(v) for k, v in given.items() if v is not None})
         return self
 
@@ -184,7 +186,7 @@ class DrillPipeBuilder:
         return self._section("materials", fields)
 
     def record(self, **fields: Any) -> Self:
-        """`tables`, `bodies`, `contacts`, `summary_window`."""
+        """`tables`, `bodies`, `contacts`, `summary_window` [s], `max_bytes` [B]."""
         return self._section("record", fields)
 
     def to_dict(self) -> dict[str, Any]:

@@ -153,12 +153,14 @@ impl Document {
         state: State,
     ) -> Result<Self, SceneError> {
         crate::sim::initial_energy_is_finite(&model, &state)?;
-        Ok(Self {
+        let doc = Self {
             source,
             scene,
             model,
             state,
-        })
+        };
+        crate::record::check_budget(&doc.model, &doc.observers())?;
+        Ok(doc)
     }
 
     /// The document's kind.
@@ -246,6 +248,12 @@ impl Document {
                 ))]
             }
         }
+    }
+
+    /// The estimated size of every table a run of the document records (at
+    /// most; checked against `record.max_bytes` when the document was made).
+    pub fn memory_estimate(&self) -> Vec<crate::record::TableEstimate> {
+        crate::record::estimate(&self.model, &self.observers())
     }
 
     /// A new simulation of the document, at t = 0 with its first frame recorded.
@@ -351,6 +359,7 @@ pub fn field_unit(section: &str, key: &str, table: &toml::Table) -> Option<Strin
         ("world", "gravity") => Some("m/s²"),
         ("newton", _) | ("divergence", "penetration_fraction" | "energy_growth") => Some("-"),
         ("record", "summary_window") => Some("s"),
+        ("record", "max_bytes") => Some("B"),
         _ => None,
     };
     exact.or_else(|| named_unit(key)).map(str::to_string)

@@ -206,6 +206,8 @@ pub struct RecordPlan {
     pub pairs: Vec<usize>,
     /// Window `[start, end]` of the `summary` table [s].
     pub summary_window: (f64, f64),
+    /// Most memory the recorded tables may take [B] (`record.max_bytes`).
+    pub max_bytes: u64,
 }
 
 /// Read-only after assembly.

@@ -69,6 +69,7 @@ impl Simulation {
     pub fn new(scene: &Scene) -> Result<Self, SceneError> {
         let (model, state) = assemble(scene)?;
         initial_energy_is_finite(&model, &state)?;
+        crate::record::check_budget(&model, &[])?;
         Ok(Self::from_model(model, state, vec![], scene.to_toml()))
     }
 

@@ -95,6 +95,7 @@ fn record_plan(
             [a, b] => (*a, *b),
             _ => (0.0, f64::INFINITY),
         },
+        max_bytes: r.max_bytes,
         pairs: if r.contacts.is_empty() {
             (0..pairs.len()).collect()
         } else {

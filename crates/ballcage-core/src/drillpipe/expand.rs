@@ -642,6 +642,7 @@ impl<'a> Builder<'a> {
             },
             contacts: r.contacts.clone(),
             summary_window: r.summary_window.clone(),
+            max_bytes: r.max_bytes,
         };
         let scene = Scene {
             name: spec.title(),

@@ -335,6 +335,22 @@ impl Observer for PipeTables {
         self.tables.iter().filter_map(|t| table_def(*t)).collect()
     }
 
+    fn rows(&self, frames: u64) -> Vec<u64> {
+        let l = &self.layout;
+        let per_frame = |n: usize| frames.saturating_mul(n as u64);
+        self.tables
+            .iter()
+            .map(|t| match t {
+                PipeTable::Links => per_frame(l.chain.len().saturating_sub(2)),
+                PipeTable::Hinges => per_frame(l.hinges.len()),
+                PipeTable::Keys => per_frame(l.hinges.iter().map(|h| h.keys.len()).sum()),
+                PipeTable::Drive => frames,
+                PipeTable::Pairs => l.pairs.len() as u64,
+                _ => 0,
+            })
+            .collect()
+    }
+
     fn needs_contacts(&self) -> bool {
         self.tables.iter().any(|t| *t != PipeTable::Pairs)
     }

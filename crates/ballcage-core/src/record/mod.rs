@@ -8,9 +8,11 @@
 //! and [`SUMMARY`]; the output stage turns any `TableDef` into an Arrow
 //! schema, so a table is defined once, wherever it is produced.
 
+mod budget;
 mod frame;
 mod observer;
 
+pub use budget::{TableEstimate, bytes_text, check_budget, estimate, frames};
 pub use frame::Recorder;
 pub use observer::{Frame, Observer, contact_totals};
 

@@ -35,6 +35,11 @@ pub trait Observer: Debug + Send + Sync {
     /// The tables it fills, in order; fixed for the observer's lifetime.
     fn tables(&self) -> Vec<&'static TableDef>;
 
+    /// Rows each of its tables (in the order of [`Self::tables`]) holds
+    /// after `frames` recorded frames, at most: the memory estimate made
+    /// before a run ([`super::check_budget`]).
+    fn rows(&self, frames: u64) -> Vec<u64>;
+
     /// Whether it reads [`Frame::contacts`].
     fn needs_contacts(&self) -> bool;
 

@@ -408,6 +408,18 @@ pub struct RecordSpec<T: TableChoice = TableKind> {
     /// Time window `[start, end]` of the `summary` table [s]; empty means the whole run.
     #[serde(default)]
     pub summary_window: Vec<f64>,
+    /// Most memory the recorded tables may take [B]: before a run starts,
+    /// frames × rows × columns of every recorded table is estimated (an
+    /// upper bound: every contact point slot of every recorded pair in every
+    /// frame), and a scene over it is refused with the estimate. Default 4e9
+    /// (4 GB).
+    #[serde(default = "default_max_bytes")]
+    pub max_bytes: u64,
+}
+
+/// `record.max_bytes` unless a scene sets it: 4 GB, a sixth of a 24 GiB machine.
+pub(crate) fn default_max_bytes() -> u64 {
+    4_000_000_000
 }
 
 impl<T: TableChoice> RecordSpec<T> {
@@ -422,6 +434,9 @@ impl<T: TableChoice> RecordSpec<T> {
                     "listed twice",
                 ));
             }
+        }
+        if self.max_bytes == 0 {
+            return Err(SceneError::new("record.max_bytes", 0, "must be at least 1"));
         }
         validate_window("record.summary_window", &self.summary_window, duration)
     }
@@ -489,6 +504,7 @@ impl<T: TableChoice> Default for RecordSpec<T> {
             bodies: vec![],
             contacts: vec![],
             summary_window: vec![],
+            max_bytes: default_max_bytes(),
         }
     }
 }
