@@ -38,7 +38,7 @@ def test_run_without_a_scene_runs_the_paper_scene(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == "" and proc.stderr == ""
     # A drill pipe that does not choose its tables records the engineering ones besides its own.
-    tables = ["bodies", "contacts", "links", "hinges", "keys", "drive", "summary", "pairs"]
+    tables = ["bodies", "contacts", "links", "hinges", "keys", "drive", "summary", "pairs", "wear"]
     assert sorted(p.name for p in out.iterdir()) == sorted([f"{t}.parquet" for t in tables] + ["scene.toml"])
     bodies = pq.read_table(out / "bodies.parquet")
     names = set(bodies.column("body").cast("string").to_pylist())

@@ -21,7 +21,7 @@ BALL_DROP = Path(__file__).resolve().parent.parent / "examples" / "scenes" / "ba
 #: A drill-pipe run of a few seconds: the reduced hinge model, 10 ms.
 QUICK = ["--set", "simulation.duration=0.01", "--set", 'pipe.hinge="ideal-cv"', "--quiet"]
 #: What `ballcage run` records for a drill-pipe scene that does not choose (besides bodies and contacts).
-ENGINEERING = {"links", "hinges", "keys", "drive", "summary", "pairs"}
+ENGINEERING = {"links", "hinges", "keys", "drive", "summary", "pairs", "wear"}
 
 
 def _cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -103,7 +103,7 @@ def test_run_help_says_how_to_choose_tables():
     assert proc.returncode == 0
     text = " ".join(proc.stdout.split())
     assert "--tables NAME,..." in text
-    assert "links, hinges, keys, drive, summary and pairs" in text
+    assert "links, hinges, keys, drive, summary, pairs and wear" in text
     assert ", ".join(_native.TABLE_NAMES) in text
 
 

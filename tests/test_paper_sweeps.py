@@ -179,7 +179,7 @@ def test_run_paper_with_sweeps_writes_the_sweep_figures_and_trends(swept: tuple[
     out, paths = swept
     summary = pq.read_table(out / "sweeps" / "summary.parquet")
     assert summary.num_rows == 9 and set(summary.column("status").to_pylist()) == {"ok"}
-    for name in ("fig16_curvature", "fig17_speed"):
+    for name in ("fig16_curvature", "fig17_speed", "losses_curvature"):
         assert paths[name].read_bytes()[:8] == PNG_MAGIC
     trends = pq.read_table(paths["trends"])
     assert trends.column("key").to_pylist() == [

@@ -87,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 _SIZE_OPTIONS = ("--radius", "--tube-id", "--joint-od", "--length")
 #: Options whose value may be a (wrong) negative number, which argparse would take for an option.
 _NUMBER_OPTIONS = frozenset(
-    {"--steps", "--reference-dt", "--duration", "--values-per-parameter", "--bisections", *_SIZE_OPTIONS}
+    {"--steps", "--reference-dt", "--duration", "--values-per-parameter", "--bisections", "--frames", "--fps", *_SIZE_OPTIONS}
 )
 
 
@@ -121,6 +121,7 @@ def _build_parser() -> argparse.ArgumentParser:
     _add_size_command(commands)
     _add_sweep_command(commands)
     _add_chart_command(commands)
+    _add_view_command(commands)
     return parser
 
 
@@ -135,7 +136,7 @@ def _add_run_command(commands: _Commands) -> None:
         description=(
             "Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml. "
             "The tables are the scene's record.tables; a drill-pipe scene records by default bodies, "
-            "contacts and the engineering tables links, hinges, keys, drive, summary and pairs. "
+            "contacts and the engineering tables links, hinges, keys, drive, summary, pairs and wear. "
             "--tables chooses the tables instead."
         ),
     )
@@ -487,6 +488,51 @@ def _size(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_view_command(commands: _Commands) -> None:
+    view = commands.add_parser(
+        "view",
+        help="the chain seen turning in 3D: an offline HTML page (or a GIF or MP4) of a drill-pipe run",
+        description=(
+            "Draw a drill-pipe run's chain turning in its guide tube: links coloured by their tube normal force [N], "
+            "the connectors, the ball keys where their poses are recorded (record.bodies), a mark on each body that "
+            "shows it turning, and the semi-transparent tube; lengths in m. The suffix of --out picks the kind: "
+            ".html is one self-contained page with plotly.js embedded (it opens offline) with play, pause and a time "
+            "slider (FILE.html#t=1.2 opens at t = 1.2 s); .gif (Pillow) and .mp4 (needs ffmpeg) are for reports. "
+            "Poses come from bodies.parquet, or from links.parquet (com and eq. (4) angles) without it."
+        ),
+    )
+    view.add_argument(
+        "run_dir", metavar="RUN_DIR", type=Path,
+        help="a run's folder (`ballcage run --out DIR`, `ballcage paper --out DIR`, Run.write): scene.toml and "
+        "bodies.parquet or links.parquet",
+    )
+    view.add_argument(
+        "--out", "-o", metavar="FILE", required=True, type=Path,
+        help="chain.html (interactive page), chain.gif or chain.mp4 (needs ffmpeg); its folder is created",
+    )
+    view.add_argument("--frames", metavar="N", default="120", help="draw at most N frames, evenly spaced over the run (default 120)")
+    view.add_argument("--fps", metavar="FPS", default="12", help="frames per second when played (default 12)")
+    _add_quiet_option(view, "no summary line")
+    view.set_defaults(command=_view)
+
+
+def _view(args: argparse.Namespace) -> int:
+    from ballcage.view import VIEW_SUFFIXES, write_view  # deferred: numpy, plotly or matplotlib
+
+    frames = _count("--frames", args.frames, 1)
+    fps = _positive("--fps", args.fps, "a positive number of frames per second")
+    assert fps is not None
+    if args.out.suffix.lower() not in VIEW_SUFFIXES:
+        suffix = repr(args.out.suffix) if args.out.suffix else "no suffix"
+        raise UsageError(f"--out {args.out}: {suffix}: the suffix picks the kind; write {', '.join(VIEW_SUFFIXES)}")
+    if args.out.is_dir():
+        raise UsageError(f"--out {args.out}: is a directory; name the file, e.g. --out {args.out / 'chain.html'}")
+    path = write_view(args.run_dir, args.out, frames=frames, fps=fps)  # an InputError names the folder: exit 2
+    if not args.quiet:
+        print(f"wrote {path}  (3D view, {_human_size(path.stat().st_size)})")
+    return 0
+
+
 def _add_out_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--out", "-o", metavar="DIR", required=True, type=Path, help="output directory (created)")
 
@@ -581,6 +627,12 @@ def _run(args: argparse.Namespace) -> int:
         for name, path in paths.items():
             print(_summary(name, path, result.tables.get(name)))
         print(_cost(result.metadata))
+        if "wear" in result.tables:
+            from ballcage.duty import margin_line, wear_line
+
+            for line in (margin_line(result.tables["wear"]), wear_line(result.tables["wear"])):
+                if line is not None:
+                    print(f"ballcage: {line}")
     return 0
 
 
@@ -760,7 +812,9 @@ def _paper_summary(name: str, path: Path) -> str:
 
         meta = pq.ParquetFile(path).metadata
         return f"wrote {path}  ({meta.num_rows} rows x {meta.num_columns} columns, {_human_size(path.stat().st_size)})"
-    what = {"scene": "resolved scene", "comparison_md": "comparison and trends"}.get(name, "figure" if path.suffix == ".png" else name)
+    what = {"scene": "resolved scene", "comparison_md": "comparison and trends", "view": "3D view, `ballcage view`"}.get(
+        name, "figure" if path.suffix == ".png" else name
+    )
     return f"wrote {path}  ({what}, {_human_size(path.stat().st_size)})"
 
 

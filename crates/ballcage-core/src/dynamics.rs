@@ -77,8 +77,21 @@ pub fn contact_torque(
     evals: &[Vec<ContactEval>],
     body: usize,
 ) -> Vec3 {
+    pairs_torque(model, state, evals, 0..model.pairs.len(), body)
+}
+
+/// Torque of the contact forces of the pairs `pairs` on `body` about its
+/// centre of mass [N·m], world frame, as [`contact_torque`].
+pub fn pairs_torque(
+    model: &Model,
+    state: &State,
+    evals: &[Vec<ContactEval>],
+    pairs: impl IntoIterator<Item = usize>,
+    body: usize,
+) -> Vec3 {
     let mut tau = Vec3::zeros();
-    for (pair, ev) in model.pairs.iter().zip(evals) {
+    for k in pairs {
+        let (pair, ev) = (&model.pairs[k], &evals[k]);
         let sign = if pair.b == body {
             1.0
         } else if pair.a == body {

@@ -181,6 +181,11 @@ impl Document {
         &self.model
     }
 
+    /// The state at t = 0.
+    pub fn initial_state(&self) -> &State {
+        &self.state
+    }
+
     /// The drill-pipe document and the layout of its parts, for drill pipes.
     pub fn drill_pipe_parts(&self) -> Option<(&DrillPipeSpec, &Layout)> {
         match &self.source {
@@ -243,8 +248,10 @@ impl Document {
             Source::Generic => vec![],
             Source::DrillPipe { spec, layout } => {
                 vec![Box::new(PipeTables::new(
+                    spec,
                     layout.as_ref().clone(),
-                    &spec.record.tables,
+                    &self.model,
+                    &self.state,
                 ))]
             }
         }
@@ -390,6 +397,11 @@ fn named_unit(key: &str) -> Option<&'static str> {
         (&["velocity"], "m/s"),
         (&["angular_velocity", "spin_speed"], "rad/s"),
         (&["density"], "kg/m³"),
+        (&["youngs_modulus", "hardness", "allowable_pressure"], "Pa"),
+        (
+            &["poisson_ratio", "tube_coefficient", "internal_coefficient"],
+            "-",
+        ),
         (&["orientation", "normal", "axis", "spin_axis"], "-"),
         (
             &["position", "pitch", "max_penetration", "half_extents"],

@@ -56,6 +56,10 @@ struct EnergyBalance {
     initial_free: f64,
     /// Net work of the drives and applied torques so far [J].
     work_in: f64,
+    /// Of it, the drives' (prescribed motions') [J].
+    work_drive: f64,
+    /// Of it, the applied torques' [J].
+    work_load: f64,
     /// ∫|P| of each input so far [J].
     work_abs: f64,
     /// Largest gravitational energy released or stored so far, |ΔPE_g| [J].
@@ -85,7 +89,7 @@ impl Simulation {
         let mut dynamics = Dynamics::new(&model);
         let workspace = Workspace::new(&state);
         let mut recorder = Recorder::new(&model, observers);
-        recorder.record(&model, &state, 0, &mut dynamics);
+        recorder.record(&model, &state, 0, &mut dynamics, (0.0, 0.0));
         let initial_deepest = deepest_penetration(&model, &state, &mut dynamics);
         let e0 = dynamics.energy(&model, &state);
         let balance = EnergyBalance {
@@ -218,12 +222,20 @@ impl Simulation {
             return self.fail_with(reason, Failure::Penetration);
         }
         self.add_input_work(h);
+        self.recorder
+            .after_step(&self.model, &self.state, h, &mut self.dynamics);
         if self.step.is_multiple_of(self.model.steps_per_output) {
             if let Some(reason) = self.energy_created() {
                 return self.fail(reason);
             }
-            self.recorder
-                .record(&self.model, &self.state, self.step, &mut self.dynamics);
+            let b = &self.balance;
+            self.recorder.record(
+                &self.model,
+                &self.state,
+                self.step,
+                &mut self.dynamics,
+                (b.work_drive, b.work_load),
+            );
         }
         if self.dynamics.watch.saw_contact() {
             self.last_watch = self.dynamics.watch;
@@ -490,18 +502,20 @@ impl Simulation {
     /// (minus what the joints and contacts do on them) over the step, from
     /// the last force evaluation and the new velocities.
     fn add_input_work(&mut self, h: f64) {
-        let (model, state) = (&self.model, &self.state);
-        let mut add = |p: f64| {
-            self.balance.work_in += p * h;
-            self.balance.work_abs += p.abs() * h;
-        };
+        let (model, state, b) = (&self.model, &self.state, &mut self.balance);
         for l in &model.torques {
-            add(l.torque(state.t).dot(&state.omega_world(l.body)));
+            let p = l.torque(state.t).dot(&state.omega_world(l.body));
+            b.work_load += p * h;
+            b.work_in += p * h;
+            b.work_abs += p.abs() * h;
         }
         let (force, torque) = (self.dynamics.forces(), self.dynamics.torques());
-        for (i, b) in model.bodies.iter().enumerate() {
-            if matches!(b.motion, Motion::KinematicSpin(_)) {
-                add(-(force[i].dot(&state.vel[i]) + torque[i].dot(&state.omega_world(i))));
+        for (i, body) in model.bodies.iter().enumerate() {
+            if matches!(body.motion, Motion::KinematicSpin(_)) {
+                let p = -(force[i].dot(&state.vel[i]) + torque[i].dot(&state.omega_world(i)));
+                b.work_drive += p * h;
+                b.work_in += p * h;
+                b.work_abs += p.abs() * h;
             }
         }
     }

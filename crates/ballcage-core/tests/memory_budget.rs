@@ -92,15 +92,15 @@ mass = 1.0
     )
     .unwrap();
     let e = Simulation::new(&scene).unwrap_err();
-    // bodies 10 001 × 128 B (2 × 8 + 2 × 4 + 13 × 8) + energy 10 001 × 48 B (6 × 8) = 1.760 MB
+    // bodies 10 001 × 128 B (2 × 8 + 2 × 4 + 13 × 8) + energy 10 001 × 96 B (12 × 8) = 2.240 MB
     let bytes = 10_001
         * (table_def(TableKind::Bodies).row_bytes() + table_def(TableKind::Energy).row_bytes());
-    assert_eq!(bytes, 1_760_176);
-    assert!(e.reason.contains("up to 1.760 MB over 10001 frames"), "{e}");
+    assert_eq!(bytes, 2_240_224);
+    assert!(e.reason.contains("up to 2.240 MB over 10001 frames"), "{e}");
     let ok = Scene::from_toml_str(
         &scene
             .to_toml()
-            .replace("max_bytes = 1000000", "max_bytes = 1760176"),
+            .replace("max_bytes = 1000000", "max_bytes = 2240224"),
         &[],
     )
     .unwrap();

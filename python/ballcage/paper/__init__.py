@@ -7,6 +7,8 @@ every table recorded, and writes into one directory:
 - the paper's figures as PNG: ``fig09_included_angles``, ``fig10_tube_normal``,
   ``fig11_tube_tangential``, ``fig12_key_normal``, ``fig13_key_tangential``
   and ``table3_shape``;
+- ``chain.html``: the chain turning in its tube in 3D, links coloured by their
+  tube force (`ballcage.view`, at most 120 frames);
 - ``comparison.parquet`` and ``comparison.md``: one row per ``[[quantity]]``
   of the shipped reference file ``ballcage/data/paper-2023.toml``, with the
   paper's value, ours, their ratio and a note on how our definition differs

@@ -9,11 +9,11 @@ from typing import Any
 import pyarrow as pa
 
 from ballcage.paper.compare import PHASES_KEY, fmt
-from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS
+from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS, reference
 from ballcage.paper.facts import scene_facts
 from ballcage.run import Run
 
-__all__ = ["comparison_markdown"]
+__all__ = ["comparison_markdown", "duty_lines"]
 
 
 def comparison_markdown(
@@ -65,11 +65,47 @@ def comparison_markdown(
         note = note.replace("|", "\\|")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
     lines += _phase_lines(phases)
+    if run is not None and "wear" in run.tables:
+        lines += duty_lines(run)
     if section4 is not None:
         from ballcage.paper.trends import trend_markdown  # deferred: it imports the sweep machinery
 
         lines += trend_markdown(*section4)
     return "\n".join(lines) + "\n"
+
+
+def duty_lines(run: Run) -> list[str]:
+    """Beyond the paper: the paper's seat–key peak against the static contact-stress limit, this run's
+    smallest pressure margin, its friction loss by contact and the first 0.1 mm of wear (`ballcage.duty`)."""
+    from ballcage.duty import loss_breakdown, margin_line, pressure_at, wear_line
+
+    wear = run.tables["wear"]
+    lines = ["", "## Contact pressure, wear and losses (beyond the paper)", ""]
+    peak = next(q for q in reference()["quantity"] if q["key"] == "seat_key_normal_peak_n")
+    outer = pressure_at(wear, "outer-race", peak["value"])
+    inner = pressure_at(wear, "inner-race", peak["value"])
+    allowable = float(run.scene.value("materials.pipe_steel.allowable_pressure"))
+    bearing = float(run.scene.value("materials.key_steel.allowable_pressure"))
+    if outer is not None:
+        verdict = "within" if outer <= allowable else "beyond"
+        inner_text = f", {inner / 1e6:.0f} MPa on an inner race" if inner is not None else ""
+        lines.append(
+            f"- The paper's {peak['value'] / 1e3:g} kN seat–key peak (`{peak['key']}`) is **{verdict} the static "
+            f"contact-stress limit**: Hertz p0 = {outer / 1e6:.0f} MPa on an outer race{inner_text}, "
+            f"{outer / allowable:.1f}× the {allowable / 1e6:.0f} MPa the races' 35CrMo may carry "
+            f"(`materials.pipe_steel.allowable_pressure`, first yield) and {outer / bearing:.1f}× the "
+            f"{bearing / 1e6:.0f} MPa static rating of bearing steel (`materials.key_steel`)."
+        )
+    for line in (margin_line(wear), wear_line(wear)):
+        if line is not None:
+            lines.append(f"- This run: {line}.")
+    losses = loss_breakdown(wear)
+    total = sum(losses.values())
+    if total > 0.0:
+        lines += ["", "| friction loss | mean power [W] | share |", "| --- | ---: | ---: |"]
+        lines += [f"| {g} | {w:.1f} | {100 * w / total:.1f} % |" for g, w in losses.items()]
+        lines.append(f"| all | {total:.1f} | 100 % |")
+    return lines
 
 
 def _phase_lines(phases: Mapping[str, Any]) -> list[str]:

@@ -16,7 +16,9 @@ from ballcage.paper.compare import comparison
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.run import simulate
+from ballcage.duty import write_loss_figure
 from ballcage.scene import default_scene
+from ballcage.view import write_view
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -26,8 +28,12 @@ if TYPE_CHECKING:
 
 __all__ = ["PAPER_TABLES", "paper_scene", "run_paper"]
 
+#: The 3D view `run_paper` writes beside the figures (`ballcage view`), and its most frames (evenly spaced).
+VIEW_FILE, VIEW_FRAMES = "chain.html", 120
 #: Tables the paper run records.
-PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive")
+PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive", "wear")
+#: The loss breakdown `run_paper` writes beside the figures (`ballcage.duty.write_loss_figure`).
+LOSS_FILE = "losses.png"
 
 
 def run_paper(
@@ -55,9 +61,11 @@ def run_paper(
     the reference file, also listed in ``comparison.md``.
 
     Returns the written paths: one per table (``"bodies"``, …), ``"scene"``,
-    one per figure (``"fig09_included_angles"``, …), ``"comparison"``,
+    one per figure (``"fig09_included_angles"``, …), ``"losses"`` (``losses.png``,
+    the friction loss by contact, `ballcage.duty`), ``"view"`` (``chain.html``,
+    the chain turning in 3D, `ballcage.view`), ``"comparison"``,
     ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder),
-    ``"fig16_curvature"``, ``"fig17_speed"`` and ``"trends"``. Raises
+    ``"fig16_curvature"``, ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``. Raises
     `ballcage.SceneError` for an invalid override and `ballcage.SimulationError`
     when the main run diverges (a sweep case that diverges is recorded in the
     sweep's summary and its rows stay empty).
@@ -75,6 +83,8 @@ def run_paper(
     run = simulate(main_scene, progress=progress)
     written = run.write(out)
     written.update(write_figures(run, out))
+    written["losses"] = write_loss_figure(run.tables["wear"], out / LOSS_FILE)
+    written["view"] = write_view(run, out / VIEW_FILE, frames=VIEW_FRAMES)
     section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
     sweep_runs = section4[0].variant_runs() if section4 is not None else None
     table = comparison(run, sweep_runs)

@@ -31,13 +31,14 @@ if TYPE_CHECKING:
 __all__ = ["SECTION4_FIGURES", "hinge_key_peaks", "link_inclinations", "write_section4_figures"]
 
 #: Figure files (without ``.png``).
-SECTION4_FIGURES: tuple[str, ...] = ("fig16_curvature", "fig17_speed")
+SECTION4_FIGURES: tuple[str, ...] = ("fig16_curvature", "fig17_speed", "losses_curvature")
 
 
 def write_section4_figures(
     curvature: Mapping[float, Run], speed: Mapping[float, Run], out_dir: str | os.PathLike[str]
 ) -> dict[str, Path]:
-    """Writes ``fig16_curvature.png`` (runs by R [m]) and ``fig17_speed.png`` (runs by rpm); returns the paths."""
+    """Writes ``fig16_curvature.png`` (runs by R [m]), ``fig17_speed.png`` (runs by rpm) and, beyond the
+    paper, ``losses_curvature.png`` (efficiency and friction loss by contact against R); returns the paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     fig16 = _figure({f"R = {r:g} m": run for r, run in sorted(curvature.items())},
@@ -47,7 +48,41 @@ def write_section4_figures(
     return {
         "fig16_curvature": write_png(fig16, out / "fig16_curvature.png"),
         "fig17_speed": write_png(fig17, out / "fig17_speed.png"),
+        "losses_curvature": write_png(_losses_figure(curvature), out / "losses_curvature.png"),
     }
+
+
+def _losses_figure(curvature: Mapping[float, Run]) -> Figure:
+    """Beyond the paper: drive efficiency against R, and the friction loss by contact (`ballcage.duty`) per R."""
+    from ballcage.duty import loss_breakdown
+    from ballcage.studies.sweep_quantities import efficiency
+
+    fig = figure(figsize=(12, 4.8))
+    eff_ax, loss_ax = fig.subplots(1, 2)
+    radii = sorted(curvature)
+    eff = {r: e for r in radii if (e := efficiency(curvature[r])) is not None}
+    if eff:
+        eff_ax.plot(list(eff), [100 * e for e in eff.values()], marker="o")
+    else:
+        no_data(eff_ax, "no finished case")
+    eff_ax.set(xlabel="borehole curvature radius R [m]", ylabel="drive efficiency [%]",
+               title="Load-transfer efficiency (mean output / mean input power, summary window)")
+    losses = {r: loss_breakdown(curvature[r].tables["wear"]) for r in radii if "wear" in curvature[r].tables}
+    if losses:
+        groups = list(next(iter(losses.values())))
+        bottom = np.zeros(len(losses))
+        width = 0.8 * min(np.diff(list(losses)), default=0.5)
+        for group, style in zip(groups, series_styles(len(groups)), strict=True):
+            heights = np.array([losses[r][group] for r in losses])
+            loss_ax.bar(list(losses), heights, bottom=bottom, width=width, color=style["color"], label=group)
+            bottom += heights
+        loss_ax.legend(fontsize=8)
+    else:
+        no_data(loss_ax, "no wear table in the cases")
+    loss_ax.set(xlabel="borehole curvature radius R [m]", ylabel="mean friction power [W]",
+                title="Friction loss by contact (wear window)")
+    fig.suptitle("Where the power goes against the borehole curvature (100 rpm)", fontsize=10)
+    return fig
 
 
 def link_inclinations(run: Run) -> dict[int, float]:

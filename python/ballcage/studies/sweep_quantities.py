@@ -97,11 +97,12 @@ def case_quantities(run: Run | None) -> dict[str, float | None]:
         for link in sorted(tube.normal_mean):
             mean, peak = link_columns(link)
             out[mean], out[peak] = tube.normal_mean[link], tube.normal_peak[link]
-    out["efficiency"] = _efficiency(run)
+    out["efficiency"] = efficiency(run)
     return out
 
 
-def _efficiency(run: Run) -> float | None:
+def efficiency(run: Run) -> float | None:
+    """Drive efficiency over the summary window: mean output power / mean input power; ``None`` without a drive."""
     drive = run.tables.get("drive")
     if drive is None or drive.num_rows == 0:
         return None

@@ -16,6 +16,7 @@
 //! | `names` | the one place part names are formatted |
 //! | `layout` | body and pair ids of the parts |
 //! | `tables` | the drill pipe's output tables and their observer |
+//! | `stress` | Hertz contact pressure and Archard wear of each pair |
 //! | `sizing` | eq. (9) both ways and the articulation limit |
 //! | `chain` | placement along the centreline, eq. (4)/(5) |
 //! | `cv` | exact constant-velocity ball-cage geometry |
@@ -27,6 +28,7 @@ mod layout;
 pub mod names;
 pub mod sizing;
 mod spec;
+pub mod stress;
 pub mod tables;
 
 pub use expand::Expansion;
@@ -34,5 +36,6 @@ pub use layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
 pub use spec::{
     BallKeySpec, BoreholeSpec, DrillPipeSpec, DriveSpec, GravitySpec, HingeModel, IdealCvSpec,
     KIND, MaterialSpec, MaterialsSpec, PipeRecordSpec, PipeSpec, PipeTable, ResistingMomentSpec,
+    SolidSpec, WearSpec,
 };
 pub use tables::PipeTables;

@@ -181,6 +181,12 @@ pub struct PipeSpec {
     /// law, in both hinge models. 0 builds no neck contact: the hinges bend
     /// freely.
     pub neck_radius: f64,
+    /// Radius of the rounded edge of each link's end rim [m], for the
+    /// contact pressure of a rim on the tube (a sharp edge has no Hertz
+    /// solution). PROPOSAL: 2 mm; the rim pressure goes as about
+    /// r_e^(−0.4) (docs/model.md, "Contact pressure"). Used only by the
+    /// pressure and wear outputs.
+    pub link_edge_radius: f64,
     /// Ball-cage joint details (used by `hinge = "ball-keys"`; its seat
     /// and cage dimensions also set the articulation limit of both models).
     pub ball_keys: BallKeySpec,
@@ -203,6 +209,7 @@ impl Default for PipeSpec {
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
             tube_contact_points: 5,
             neck_radius: 0.019,
+            link_edge_radius: 0.002,
             ball_keys: BallKeySpec::default(),
             ideal_cv: IdealCvSpec::default(),
         }
@@ -277,7 +284,69 @@ fn adams(mu_static: f64, mu_dynamic: f64) -> FrictionLawSpec {
     }
 }
 
-/// The two contact materials of the paper.
+/// A solid of the pipe's parts: elasticity for the Hertz contact pressure,
+/// hardness for Archard wear, and the pressure it may carry [Pa, –]. Used
+/// only by the pressure and wear outputs, never by the contact laws.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolidSpec {
+    /// Young's modulus E [Pa].
+    pub youngs_modulus: f64,
+    /// Poisson's ratio ν [–].
+    pub poisson_ratio: f64,
+    /// Indentation hardness H [Pa] (Vickers hardness as a pressure: HV × 9.807 MPa).
+    pub hardness: f64,
+    /// Largest static peak contact pressure p₀ the surface may carry [Pa].
+    pub allowable_pressure: f64,
+}
+
+impl SolidSpec {
+    /// 35CrMo, quenched and tempered, the paper's material for the guide
+    /// tube and the drill pipe: E 210 GPa and ν 0.3 as the paper gives them.
+    /// PROPOSAL: hardness HV 300 (2.94 GPa; Q&T 35CrMo is HB 270–300) and
+    /// the allowable p₀ = 1.60·σ_y = 1.336 GPa, where a Hertz point contact
+    /// first yields below the surface (Johnson, *Contact Mechanics*, 1985,
+    /// §6.2, ν = 0.3), with σ_y ≥ 835 MPa (GB/T 3077).
+    fn pipe_steel() -> Self {
+        Self {
+            youngs_modulus: 2.1e11,
+            poisson_ratio: 0.3,
+            hardness: 2.94e9,
+            allowable_pressure: 1.336e9,
+        }
+    }
+
+    /// Through-hardened bearing steel (GCr15 / 100Cr6, 60–64 HRC) for the
+    /// ball keys. PROPOSAL: E 208 GPa, ν 0.3, hardness HV 750 (7.36 GPa),
+    /// allowable p₀ 4.2 GPa, the static rating of ball bearings (ISO 76).
+    fn key_steel() -> Self {
+        Self {
+            youngs_modulus: 2.08e11,
+            poisson_ratio: 0.3,
+            hardness: 7.36e9,
+            allowable_pressure: 4.2e9,
+        }
+    }
+
+    fn validate(&self, path: &str) -> Result<(), SceneError> {
+        positive(&format!("{path}.youngs_modulus"), self.youngs_modulus)?;
+        finite(&format!("{path}.poisson_ratio"), self.poisson_ratio)?;
+        if !(0.0..0.5).contains(&self.poisson_ratio) {
+            return Err(SceneError::new(
+                format!("{path}.poisson_ratio"),
+                self.poisson_ratio,
+                "must lie in [0, 0.5)",
+            ));
+        }
+        positive(&format!("{path}.hardness"), self.hardness)?;
+        positive(
+            &format!("{path}.allowable_pressure"),
+            self.allowable_pressure,
+        )
+    }
+}
+
+/// The two contact materials of the paper, and the two solids.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct MaterialsSpec {
@@ -285,6 +354,11 @@ pub struct MaterialsSpec {
     pub tube: MaterialSpec,
     /// Inside the joints (lubricated): μs 0.1, μd 0.01.
     pub internal: MaterialSpec,
+    /// The links, connectors, ball heads and seats, cages and the guide
+    /// tube: 35CrMo (the paper).
+    pub pipe_steel: SolidSpec,
+    /// The ball keys: bearing steel (PROPOSAL).
+    pub key_steel: SolidSpec,
 }
 
 impl Default for MaterialsSpec {
@@ -298,7 +372,41 @@ impl Default for MaterialsSpec {
                 normal: paper_impact(),
                 friction: adams(0.1, 0.01),
             },
+            pipe_steel: SolidSpec::pipe_steel(),
+            key_steel: SolidSpec::key_steel(),
         }
+    }
+}
+
+/// Archard wear coefficients k [–] of the `wear` table: wear volume
+/// V = k·∫F_n ds / H. The wear figures scale with k, which spans orders of
+/// magnitude between conditions and no simulation sets; ∫F_n ds is the
+/// simulated quantity.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WearSpec {
+    /// Link–guide tube, dry steel on steel in mild wear. PROPOSAL: 1e-4
+    /// (mild wear of metals, 1e-5–1e-3: Hutchings & Shipway, *Tribology*,
+    /// 2nd ed., 2017, §5.3).
+    pub tube_coefficient: f64,
+    /// Inside the joints, boundary-lubricated steel. PROPOSAL: 1e-7
+    /// (lubricated, 1e-6–1e-9: ibid.).
+    pub internal_coefficient: f64,
+}
+
+impl Default for WearSpec {
+    fn default() -> Self {
+        Self {
+            tube_coefficient: 1e-4,
+            internal_coefficient: 1e-7,
+        }
+    }
+}
+
+impl WearSpec {
+    fn validate(&self) -> Result<(), SceneError> {
+        non_negative("wear.tube_coefficient", self.tube_coefficient)?;
+        non_negative("wear.internal_coefficient", self.internal_coefficient)
     }
 }
 
@@ -343,8 +451,10 @@ pub struct DrillPipeSpec {
     pub drive: DriveSpec,
     /// Resisting moment.
     pub load: ResistingMomentSpec,
-    /// Contact materials.
+    /// Contact materials and solids.
     pub materials: MaterialsSpec,
+    /// Archard wear coefficients of the `wear` table.
+    pub wear: WearSpec,
     /// What to record.
     pub record: PipeRecordSpec,
 }
@@ -407,6 +517,7 @@ impl Default for DrillPipeSpec {
             drive: DriveSpec::default(),
             load: ResistingMomentSpec::default(),
             materials: MaterialsSpec::default(),
+            wear: WearSpec::default(),
             record: PipeRecordSpec::default(),
         }
     }
@@ -434,6 +545,9 @@ pub enum PipeTable {
     Drive,
     /// Once per run: what each contact pair is (feature, link, hinge, key, face).
     Pairs,
+    /// Once per run, per contact pair: friction work, sliding, Archard wear
+    /// and the peak contact pressure against the allowable.
+    Wear,
 }
 
 impl PipeTable {
@@ -444,7 +558,9 @@ impl PipeTable {
             Self::Contacts => Some(TableKind::Contacts),
             Self::Energy => Some(TableKind::Energy),
             Self::Summary => Some(TableKind::Summary),
-            Self::Links | Self::Hinges | Self::Keys | Self::Drive | Self::Pairs => None,
+            Self::Links | Self::Hinges | Self::Keys | Self::Drive | Self::Pairs | Self::Wear => {
+                None
+            }
         }
     }
 }
@@ -462,6 +578,7 @@ impl TableChoice for PipeTable {
             PipeTable::Drive,
             PipeTable::Summary,
             PipeTable::Pairs,
+            PipeTable::Wear,
         ]
     }
 
@@ -472,6 +589,7 @@ impl TableChoice for PipeTable {
             Self::Keys => "keys",
             Self::Drive => "drive",
             Self::Pairs => "pairs",
+            Self::Wear => "wear",
             engine => engine.engine().map_or("", TableKind::name),
         }
     }
@@ -509,6 +627,9 @@ impl DrillPipeSpec {
             finite("load.resisting_moment", self.load.resisting_moment),
             non_negative("load.ramp", self.load.ramp),
             finite("world.gravity", self.world.gravity),
+            self.materials.pipe_steel.validate("materials.pipe_steel"),
+            self.materials.key_steel.validate("materials.key_steel"),
+            self.wear.validate(),
             self.record.validate_tables(self.simulation.duration),
         ])
     }
@@ -561,6 +682,7 @@ impl PipeSpec {
         }
         positive("pipe.pitch", self.pitch)?;
         positive("pipe.link_diameter", self.link_diameter)?;
+        positive("pipe.link_edge_radius", self.link_edge_radius)?;
         if self.link_diameter >= borehole.inner_diameter {
             return Err(SceneError::new(
                 "pipe.link_diameter",

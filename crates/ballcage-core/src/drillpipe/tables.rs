@@ -3,13 +3,14 @@
 //! `keys` and `drive`. Parts are identified by integer columns (`link`,
 //! `hinge`, `key`), never by names.
 
-use super::layout::{Feature, KeyLayout, Layout};
-use super::spec::PipeTable;
+use super::layout::{Feature, HingeLayout, KeyLayout, Layout};
+use super::spec::{DrillPipeSpec, PipeTable};
+use super::stress::{PairStress, PairWear, WEAR, pair_stresses, wear_rows};
 use crate::math::{Vec3, angle_between};
-use crate::model::Motion;
+use crate::model::{Model, Motion, State};
 use crate::record::{
-    Cell, ColumnDef, ColumnKind, Dictionary, Frame, Observer, STEP, TIME, TableBuffer, TableDef,
-    col, contact_totals,
+    Cell, ColumnDef, ColumnKind, Dictionary, Frame, Observer, STEP, Step, TIME, TableBuffer,
+    TableDef, col, contact_totals,
 };
 
 use ColumnKind::{F64, Name, OptF64, OptU32, U32};
@@ -76,6 +77,12 @@ const LINKS_COLUMNS: &[ColumnDef] = &[
         "N",
         "magnitude of the summed friction force of the link's contact with the tube",
     ),
+    col(
+        "tube_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ of the link's most loaded tube contact: a line along the wall, an elliptical patch at a rim rounded to pipe.link_edge_radius; 0 without contact",
+    ),
 ];
 
 /// Columns of the `hinges` table (drill pipe): one row per hinge per frame.
@@ -124,6 +131,42 @@ const HINGES_COLUMNS: &[ColumnDef] = &[
         F64,
         "N",
         "friction force magnitude between the head's neck and the seat's mouth",
+    ),
+    col(
+        "cage_head_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ between cage and ball head (sphere in a conforming cavity: an estimate once the patch nears the radius); 0 without contact",
+    ),
+    col(
+        "cage_seat_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ between cage and ball seat, as cage_head_pressure",
+    ),
+    col(
+        "torque_in",
+        F64,
+        "N*m",
+        "spin torque the upper body hands to the hinge: minus the axial moment of the hinge's contacts and joint on it, about its own axis",
+    ),
+    col(
+        "torque_out",
+        F64,
+        "N*m",
+        "spin torque the hinge hands to the lower body: the axial moment of the hinge's contacts and joint on it, about its own axis",
+    ),
+    col(
+        "power_in",
+        F64,
+        "W",
+        "torque_in × the upper body's spin speed",
+    ),
+    col(
+        "power_out",
+        F64,
+        "W",
+        "torque_out × the lower body's spin speed; power_in − power_out is lost in the hinge (friction, damping) or stored in its cage and keys",
     ),
 ];
 
@@ -182,6 +225,24 @@ const KEYS_COLUMNS: &[ColumnDef] = &[
         "deg",
         "operating contact angle on the outer race, as inner_contact_angle_deg; null without contact",
     ),
+    col(
+        "inner_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ on the inner race: ball in the torus-section flank, the more loaded flank; 0 without contact",
+    ),
+    col(
+        "outer_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ on the outer race, as inner_pressure",
+    ),
+    col(
+        "window_pressure",
+        F64,
+        "Pa",
+        "Hertz peak pressure p₀ on the cage window faces (ball on a flat); 0 without contact",
+    ),
 ];
 
 /// Columns of the `drive` table (drill pipe): one row per frame.
@@ -219,6 +280,36 @@ const DRIVE_COLUMNS: &[ColumnDef] = &[
         F64,
         "1",
         "output_power / input_power; 0 while the input power is not positive",
+    ),
+    col(
+        "friction_tube",
+        F64,
+        "W",
+        "power friction dissipates between the links and the tube, Σ|F_t|·v_slip",
+    ),
+    col(
+        "friction_key_race",
+        F64,
+        "W",
+        "power friction dissipates between the ball keys and their races",
+    ),
+    col(
+        "friction_key_window",
+        F64,
+        "W",
+        "power friction dissipates between the ball keys and the cage windows",
+    ),
+    col(
+        "friction_cage",
+        F64,
+        "W",
+        "power friction dissipates between the cages and the ball heads and seats",
+    ),
+    col(
+        "friction_neck",
+        F64,
+        "W",
+        "power friction dissipates between the necks and the seats' mouths",
     ),
 ];
 
@@ -296,7 +387,7 @@ pub const PAIRS: TableDef = TableDef {
 };
 
 /// The drill pipe's tables, in the order `ballcage schema` lists them.
-pub const TABLES: [&TableDef; 5] = [&LINKS, &HINGES, &KEYS, &DRIVE, &PAIRS];
+pub const TABLES: [&TableDef; 6] = [&LINKS, &HINGES, &KEYS, &DRIVE, &PAIRS, &WEAR];
 
 /// The drill pipe's own table of a `record.tables` entry, if it is one.
 pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
@@ -306,6 +397,7 @@ pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
         PipeTable::Keys => Some(&KEYS),
         PipeTable::Drive => Some(&DRIVE),
         PipeTable::Pairs => Some(&PAIRS),
+        PipeTable::Wear => Some(&WEAR),
         PipeTable::Bodies | PipeTable::Contacts | PipeTable::Energy | PipeTable::Summary => None,
     }
 }
@@ -315,18 +407,39 @@ pub fn table_def(table: PipeTable) -> Option<&'static TableDef> {
 pub struct PipeTables {
     layout: Layout,
     tables: Vec<PipeTable>,
+    /// The Hertz and wear model of each pair, by pair id.
+    stress: Vec<PairStress>,
+    /// The `wear` table's integrals, by pair id (empty unless it is recorded).
+    wear: Vec<PairWear>,
+    /// Window `[start, end]` of the wear integrals [s] (`record.summary_window`).
+    window: (f64, f64),
 }
 
 impl PipeTables {
-    /// An observer of the pipe laid out as `layout`, for the drill-pipe
-    /// entries of `tables` (engine tables are skipped).
-    pub fn new(layout: Layout, tables: &[PipeTable]) -> Self {
-        let tables = tables
+    /// An observer of the pipe `spec` laid out as `layout` in `model`,
+    /// starting from `state`, for the drill-pipe entries of its
+    /// `record.tables` (engine tables are skipped).
+    pub fn new(spec: &DrillPipeSpec, layout: Layout, model: &Model, state: &State) -> Self {
+        let tables: Vec<PipeTable> = spec
+            .record
+            .tables
             .iter()
             .copied()
             .filter(|t| table_def(*t).is_some())
             .collect();
-        Self { layout, tables }
+        let stress = pair_stresses(spec, &layout, model, state);
+        let wear = if tables.contains(&PipeTable::Wear) {
+            vec![PairWear::default(); layout.pairs.len()]
+        } else {
+            vec![]
+        };
+        Self {
+            layout,
+            tables,
+            stress,
+            wear,
+            window: model.record.summary_window,
+        }
     }
 }
 
@@ -345,7 +458,7 @@ impl Observer for PipeTables {
                 PipeTable::Hinges => per_frame(l.hinges.len()),
                 PipeTable::Keys => per_frame(l.hinges.iter().map(|h| h.keys.len()).sum()),
                 PipeTable::Drive => frames,
-                PipeTable::Pairs => l.pairs.len() as u64,
+                PipeTable::Pairs | PipeTable::Wear => l.pairs.len() as u64,
                 _ => 0,
             })
             .collect()
@@ -356,14 +469,39 @@ impl Observer for PipeTables {
     }
 
     fn record(&mut self, frame: &Frame<'_>, out: &mut [TableBuffer]) {
+        let (layout, stress) = (&self.layout, &self.stress[..]);
         for (table, kind) in out.iter_mut().zip(&self.tables) {
             match kind {
-                PipeTable::Links => links(table, &self.layout, frame),
-                PipeTable::Hinges => hinges(table, &self.layout, frame),
-                PipeTable::Keys => keys(table, &self.layout, frame),
-                PipeTable::Drive => drive(table, &self.layout, frame),
-                PipeTable::Pairs => pairs(table, &self.layout),
+                PipeTable::Links => links(table, layout, stress, frame),
+                PipeTable::Hinges => hinges(table, layout, stress, frame),
+                PipeTable::Keys => keys(table, layout, stress, frame),
+                PipeTable::Drive => drive(table, layout, frame),
+                PipeTable::Pairs => pairs(table, layout),
                 _ => {}
+            }
+        }
+    }
+
+    fn needs_steps(&self) -> bool {
+        !self.wear.is_empty()
+    }
+
+    fn step(&mut self, step: &Step<'_>) {
+        let t = step.state.t;
+        let (start, end) = self.window;
+        // the step (t − h, t] counts toward the window when it ends inside it
+        let in_window = t > start + 1e-12 && t <= end + 1e-12;
+        for ((w, s), points) in self.wear.iter_mut().zip(&self.stress).zip(step.contacts) {
+            w.add(s, step.state, points, step.h, in_window);
+        }
+    }
+
+    fn finish(&mut self, _model: &Model, end_time: f64, out: &mut [TableBuffer]) {
+        let (start, end) = self.window;
+        for (table, kind) in out.iter_mut().zip(&self.tables) {
+            if *kind == PipeTable::Wear {
+                let window = (start, end.min(end_time));
+                wear_rows(table, &self.layout, &self.stress, &self.wear, window);
             }
         }
     }
@@ -401,7 +539,16 @@ fn axis(f: &Frame<'_>, i: usize) -> Vec3 {
     f.state.rot[i] * Vec3::x()
 }
 
-fn links(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+/// The largest Hertz peak pressure [Pa] of the points of `pairs` (0 without contact).
+fn peak_pressure(stress: &[PairStress], f: &Frame<'_>, pairs: &[usize]) -> f64 {
+    pairs
+        .iter()
+        .flat_map(|&k| f.contacts[k].iter().map(move |e| (k, e)))
+        .map(|(k, e)| stress[k].patch(f.state, e).0.peak_pressure)
+        .fold(0.0, f64::max)
+}
+
+fn links(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Frame<'_>) {
     let (step, t) = stamp(f);
     let chain = &layout.chain;
     for k in 1..chain.len().saturating_sub(1) {
@@ -411,7 +558,8 @@ fn links(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
         let c = f.state.pos[i];
         let (offset, outward, lateral) = layout.offsets(&c);
         let included = 180.0 - angle_between(&d, &axis(f, chain[k + 1])).to_degrees();
-        let (tube_n, tube_t) = contact_totals(f.contacts, &layout.tube_pairs[k - 1..k]);
+        let tube = &layout.tube_pairs[k - 1..k];
+        let (tube_n, tube_t) = contact_totals(f.contacts, tube);
         table.push(&[
             step,
             t,
@@ -428,17 +576,21 @@ fn links(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
             Cell::F64(lateral),
             Cell::F64(tube_n),
             Cell::F64(tube_t),
+            Cell::F64(peak_pressure(stress, f, tube)),
         ]);
     }
 }
 
-fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+fn hinges(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Frame<'_>) {
     let (step, t) = stamp(f);
     for (h, hinge) in layout.hinges.iter().enumerate() {
-        let bend = angle_between(&axis(f, layout.chain[h]), &axis(f, layout.chain[h + 1]));
+        let (upper, lower) = (layout.chain[h], layout.chain[h + 1]);
+        let bend = angle_between(&axis(f, upper), &axis(f, lower));
         let (hn, ht) = contact_totals(f.contacts, hinge.cage_head.as_slice());
         let (sn, st) = contact_totals(f.contacts, hinge.cage_seat.as_slice());
         let (nn, nt) = contact_totals(f.contacts, hinge.neck.as_slice());
+        let (torque_in, speed_in) = hinge_torque(f, hinge, upper, lower, upper);
+        let (torque_out, speed_out) = hinge_torque(f, hinge, upper, lower, lower);
         table.push(&[
             step,
             t,
@@ -450,8 +602,49 @@ fn hinges(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
             Cell::F64(st),
             Cell::F64(nn),
             Cell::F64(nt),
+            Cell::F64(peak_pressure(stress, f, hinge.cage_head.as_slice())),
+            Cell::F64(peak_pressure(stress, f, hinge.cage_seat.as_slice())),
+            Cell::F64(-torque_in),
+            Cell::F64(torque_out),
+            Cell::F64(-torque_in * speed_in),
+            Cell::F64(torque_out * speed_out),
         ]);
     }
+}
+
+/// The axial moment [N·m] of hinge `hinge`'s contacts (head, seat and neck
+/// pairs of its keys and cage) and of its joint on `body` (its `upper` or
+/// `lower` chain body), about that body's own axis (body x) through its
+/// centre of mass, and the body's spin speed about that axis [rad/s].
+fn hinge_torque(
+    f: &Frame<'_>,
+    hinge: &HingeLayout,
+    upper: usize,
+    lower: usize,
+    body: usize,
+) -> (f64, f64) {
+    let (model, s) = (f.model, f.state);
+    let pairs = hinge
+        .cage_head
+        .iter()
+        .chain(&hinge.cage_seat)
+        .chain(&hinge.neck)
+        .chain(
+            hinge
+                .keys
+                .iter()
+                .flat_map(|k| k.inner.iter().chain(&k.outer)),
+        )
+        .copied();
+    let contacts = crate::dynamics::pairs_torque(model, s, f.contacts, pairs, body);
+    let joints: Vec3 = model
+        .joints
+        .iter()
+        .filter(|j| (j.a, j.b) == (upper, lower) || (j.a, j.b) == (lower, upper))
+        .map(|j| j.torque_on(s, body))
+        .sum();
+    let e = axis(f, body);
+    ((contacts + joints).dot(&e), s.omega_world(body).dot(&e))
 }
 
 /// The operating contact angle [deg] of key `key` on the race of body
@@ -482,7 +675,7 @@ fn contact_angle(
     (weight > 0.0).then(|| (sum / weight).to_degrees())
 }
 
-fn keys(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
+fn keys(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Frame<'_>) {
     let (step, t) = stamp(f);
     for (h, hinge) in layout.hinges.iter().enumerate() {
         let (head, seat) = (layout.chain[h], layout.chain[h + 1]);
@@ -505,6 +698,9 @@ fn keys(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
                 Cell::F64(w_t),
                 Cell::OptF64(inner),
                 Cell::OptF64(outer),
+                Cell::F64(peak_pressure(stress, f, &key.inner)),
+                Cell::F64(peak_pressure(stress, f, &key.outer)),
+                Cell::F64(peak_pressure(stress, f, &key.window)),
             ]);
         }
     }
@@ -553,6 +749,7 @@ fn drive(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
     let p_in = input_torque * input_speed;
     let p_out = output_torque * output_speed;
     let efficiency = if p_in > 1e-9 { p_out / p_in } else { 0.0 };
+    let friction = friction_by_feature(layout, f);
     table.push(&[
         step,
         t,
@@ -563,5 +760,30 @@ fn drive(table: &mut TableBuffer, layout: &Layout, f: &Frame<'_>) {
         Cell::F64(p_in),
         Cell::F64(p_out),
         Cell::F64(efficiency),
+        Cell::F64(friction[0]),
+        Cell::F64(friction[1]),
+        Cell::F64(friction[2]),
+        Cell::F64(friction[3]),
+        Cell::F64(friction[4]),
     ]);
+}
+
+/// Power friction dissipates [W], Σ|F_t|·v_slip, in the tube, key–race,
+/// key–window, cage (head and seat) and neck contacts.
+fn friction_by_feature(layout: &Layout, f: &Frame<'_>) -> [f64; 5] {
+    let mut out = [0.0; 5];
+    for (part, points) in layout.pairs.iter().zip(f.contacts) {
+        let i = match part.feature {
+            Feature::Tube => 0,
+            Feature::InnerRace | Feature::OuterRace => 1,
+            Feature::Window => 2,
+            Feature::CageHead | Feature::CageSeat => 3,
+            Feature::NeckMouth => 4,
+        };
+        out[i] += points
+            .iter()
+            .map(|e| e.tangential_force.norm() * e.slip_speed)
+            .sum::<f64>();
+    }
+    out
 }

@@ -15,6 +15,7 @@
 //! [`NormalLaw`] and [`FrictionLaw`] are the closed sets the engine dispatches on.
 
 pub mod friction;
+pub mod hertz;
 pub mod joint;
 pub mod normal;
 
@@ -68,18 +69,33 @@ impl NormalLaw {
         matches!(self, Self::Dissipative(..))
     }
 
+    /// Stiffness K and exponent n of the rate-independent part Kδⁿ.
+    fn spring(&self) -> (f64, f64) {
+        match self {
+            Self::Impact(p) => (p.stiffness, p.exponent),
+            Self::Dissipative(_, p) => (p.stiffness, p.exponent),
+            Self::Hertz(p) => (p.stiffness, 1.5),
+            Self::Linear(p) => (p.stiffness, 1.0),
+        }
+    }
+
     /// Elastic energy stored at depth δ [J]: ∫₀^δ of the rate-independent part.
     pub fn elastic_energy(&self, depth: f64) -> f64 {
         if depth <= 0.0 {
             return 0.0;
         }
-        let (k, n) = match self {
-            Self::Impact(p) => (p.stiffness, p.exponent),
-            Self::Dissipative(_, p) => (p.stiffness, p.exponent),
-            Self::Hertz(p) => (p.stiffness, 1.5),
-            Self::Linear(p) => (p.stiffness, 1.0),
-        };
+        let (k, n) = self.spring();
         k * depth.powf(n + 1.0) / (n + 1.0)
+    }
+
+    /// The rate-independent part Kδⁿ at depth δ [N]: the force minus it,
+    /// times δ̇, is the power the law's damping dissipates.
+    pub fn elastic_force(&self, depth: f64) -> f64 {
+        if depth <= 0.0 {
+            return 0.0;
+        }
+        let (k, n) = self.spring();
+        k * depth.powf(n)
     }
 }
 

@@ -6,8 +6,8 @@
 
 use std::ops::Range;
 
-use super::{Cell, Frame, Observer, TableBuffer, contact_totals, table_def};
-use crate::dynamics::{ContactEval, Dynamics};
+use super::{Cell, Frame, Observer, Step, TableBuffer, contact_totals, table_def};
+use crate::dynamics::{ContactEval, Dynamics, Energy};
 use crate::model::{Model, State};
 use crate::scene::TableKind;
 
@@ -64,6 +64,41 @@ impl SumOfSquares {
     }
 }
 
+/// Energy taken out of the bodies since t = 0, integrated step by step
+/// (the power at the end of each step times its length) for the `energy`
+/// table's balance.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+struct Dissipated {
+    /// By contact friction [J].
+    friction: f64,
+    /// By the normal laws' damping [J].
+    damping: f64,
+    /// Taken by the penalty joints, stored and dissipated [J].
+    joints: f64,
+}
+
+impl Dissipated {
+    /// Adds `h` [s] of the powers at `state`, contacts `evals`.
+    fn add(&mut self, model: &Model, state: &State, evals: &[Vec<ContactEval>], h: f64) {
+        for (pair, points) in model.pairs.iter().zip(evals) {
+            for e in points {
+                // Adams and tanh friction oppose the slip: −F_t·v_slip = |F_t|·|v_slip|.
+                self.friction += e.tangential_force.norm() * e.slip_speed * h;
+                let elastic = pair.normal.elastic_force(e.point.depth);
+                self.damping += (e.normal_force - elastic) * e.depth_rate * h;
+            }
+        }
+        for j in &model.joints {
+            let (w, ra, rb) = j.evaluate(state);
+            let (wa, wb) = (state.omega_world(j.a), state.omega_world(j.b));
+            let power = w.force.dot(&(state.vel[j.b] + wb.cross(&rb))) + w.torque.dot(&wb)
+                - w.force.dot(&(state.vel[j.a] + wa.cross(&ra)))
+                - w.torque.dot(&wa);
+            self.joints -= power * h;
+        }
+    }
+}
+
 /// An observer and the range of [`Recorder::tables`] it fills.
 #[derive(Debug, Clone)]
 struct Registered {
@@ -82,6 +117,11 @@ pub struct Recorder {
     evals: Vec<Vec<ContactEval>>,
     stats: Vec<PairStats>,
     needs_pairs: bool,
+    /// Whether anything reads every step: the `energy` table or an observer.
+    needs_steps: bool,
+    dissipated: Dissipated,
+    /// Mechanical energy at the first frame [J].
+    initial_total: Option<f64>,
 }
 
 impl Recorder {
@@ -100,6 +140,8 @@ impl Recorder {
             .iter()
             .any(|k| matches!(k, TableKind::Contacts | TableKind::Summary))
             || observers.iter().any(|o| o.needs_contacts());
+        let needs_steps = model.record.tables.contains(&TableKind::Energy)
+            || observers.iter().any(|o| o.needs_steps());
         let observers = observers
             .into_iter()
             .map(|observer| {
@@ -118,11 +160,47 @@ impl Recorder {
             evals: vec![Vec::new(); model.pairs.len()],
             stats: vec![PairStats::default(); model.pairs.len()],
             needs_pairs,
+            needs_steps,
+            dissipated: Dissipated::default(),
+            initial_total: None,
         }
     }
 
-    /// Records the frame of `state` at integrator step `step`.
-    pub fn record(&mut self, model: &Model, state: &State, step: u64, dynamics: &mut Dynamics) {
+    /// Integrates what the `energy` table and the observers read every step
+    /// over the step of length `h` [s] that ended at `state`: one more
+    /// evaluation of every pair's contact points, only if anything reads it.
+    pub fn after_step(&mut self, model: &Model, state: &State, h: f64, dynamics: &mut Dynamics) {
+        if !self.needs_steps {
+            return;
+        }
+        for (k, out) in self.evals.iter_mut().enumerate() {
+            out.clear();
+            dynamics.contact_points(model, state, k, out);
+        }
+        self.dissipated.add(model, state, &self.evals, h);
+        let view = Step {
+            model,
+            state,
+            h,
+            contacts: &self.evals,
+        };
+        for r in &mut self.observers {
+            if r.observer.needs_steps() {
+                r.observer.step(&view);
+            }
+        }
+    }
+
+    /// Records the frame of `state` at integrator step `step`; `input_work`
+    /// is the work of the drives and of the applied torques since t = 0 [J].
+    pub fn record(
+        &mut self,
+        model: &Model,
+        state: &State,
+        step: u64,
+        dynamics: &mut Dynamics,
+        input_work: (f64, f64),
+    ) {
         if self.needs_pairs {
             for (k, out) in self.evals.iter_mut().enumerate() {
                 out.clear();
@@ -134,7 +212,11 @@ impl Recorder {
             match kind {
                 TableKind::Bodies => bodies(table, model, state, frame),
                 TableKind::Contacts => contacts(table, model, &self.evals, frame),
-                TableKind::Energy => energy(table, model, state, dynamics, frame),
+                TableKind::Energy => {
+                    let e = dynamics.energy(model, state);
+                    let initial = *self.initial_total.get_or_insert(e.total());
+                    energy(table, &e, initial, input_work, &self.dissipated, frame);
+                }
                 TableKind::Summary => {
                     let (start, end) = model.record.summary_window;
                     if state.t >= start - 1e-12 && state.t <= end + 1e-12 {
@@ -156,8 +238,13 @@ impl Recorder {
         }
     }
 
-    /// Writes the end-of-run rows (the summary) and hands over the tables.
+    /// Writes the end-of-run rows (the summary, the observers') and hands
+    /// over the tables.
     pub fn finish(mut self, model: &Model, end_time: f64) -> Vec<TableBuffer> {
+        for r in &mut self.observers {
+            r.observer
+                .finish(model, end_time, &mut self.tables[r.tables.clone()]);
+        }
         let (start, end) = model.record.summary_window;
         for (table, kind) in self.tables.iter_mut().zip(&self.engine) {
             if *kind != TableKind::Summary {
@@ -247,12 +334,13 @@ fn contacts(
 
 fn energy(
     table: &mut TableBuffer,
-    model: &Model,
-    state: &State,
-    dynamics: &mut Dynamics,
+    e: &Energy,
+    initial: f64,
+    (drive, load): (f64, f64),
+    out: &Dissipated,
     (step, t): (Cell, Cell),
 ) {
-    let e = dynamics.energy(model, state);
+    let error = drive + load - (e.total() - initial) - out.friction - out.damping - out.joints;
     table.push(&[
         step,
         t,
@@ -260,6 +348,12 @@ fn energy(
         Cell::F64(e.potential_gravity),
         Cell::F64(e.potential_contact),
         Cell::F64(e.total()),
+        Cell::F64(drive),
+        Cell::F64(load),
+        Cell::F64(out.friction),
+        Cell::F64(out.damping),
+        Cell::F64(out.joints),
+        Cell::F64(error),
     ]);
 }
 

@@ -14,7 +14,7 @@ mod observer;
 
 pub use budget::{TableEstimate, bytes_text, check_budget, estimate, frames};
 pub use frame::Recorder;
-pub use observer::{Frame, Observer, contact_totals};
+pub use observer::{Frame, Observer, Step, contact_totals};
 
 use crate::scene::TableKind;
 
@@ -256,6 +256,43 @@ const ENERGY_COLUMNS: &[ColumnDef] = &[
         F64,
         "J",
         "kinetic + potential_gravity + potential_contact",
+    ),
+    col(
+        "drive_work",
+        F64,
+        "J",
+        "work the prescribed motions (drives) have done on the bodies since t = 0",
+    ),
+    col(
+        "load_work",
+        F64,
+        "J",
+        "work the applied torques have done since t = 0 (negative for a resisting moment)",
+    ),
+    col(
+        "friction_work",
+        F64,
+        "J",
+        "energy dissipated by contact friction since t = 0",
+    ),
+    col(
+        "damping_work",
+        F64,
+        "J",
+        "energy dissipated by the normal laws' damping since t = 0",
+    ),
+    col(
+        "joint_work",
+        F64,
+        "J",
+        "energy the penalty joints have taken since t = 0 (stored and dissipated)",
+    ),
+    col(
+        "balance_error",
+        F64,
+        "J",
+        "drive_work + load_work − (total − total at t = 0) − friction_work − damping_work − joint_work: \
+         the energy the integrator made (+) or lost (−)",
     ),
 ];
 

@@ -29,6 +29,22 @@ pub struct Frame<'a> {
     pub contacts: &'a [Vec<ContactEval>],
 }
 
+/// What an observer sees after every integrator step, when it asks for it
+/// ([`Observer::needs_steps`]): integrals over the run (work, sliding
+/// distance, the largest pressure) need every step, not only the frames.
+#[derive(Debug, Clone, Copy)]
+pub struct Step<'a> {
+    /// The assembled model.
+    pub model: &'a Model,
+    /// The state at the end of the step.
+    pub state: &'a State,
+    /// The step's length [s].
+    pub h: f64,
+    /// Contact points of every pair with their forces at the end of the
+    /// step, indexed by pair id.
+    pub contacts: &'a [Vec<ContactEval>],
+}
+
 /// A producer of output tables, registered with a simulation by a layer
 /// above the engine.
 pub trait Observer: Debug + Send + Sync {
@@ -45,6 +61,19 @@ pub trait Observer: Debug + Send + Sync {
 
     /// Appends the rows of one frame; `out[i]` is the buffer of `tables()[i]`.
     fn record(&mut self, frame: &Frame<'_>, out: &mut [TableBuffer]);
+
+    /// Whether it reads every step ([`Self::step`]); each step then costs
+    /// one more evaluation of the contact points. Default: no.
+    fn needs_steps(&self) -> bool {
+        false
+    }
+
+    /// Sees the end of every integrator step (only if [`Self::needs_steps`]).
+    fn step(&mut self, _step: &Step<'_>) {}
+
+    /// Appends the end-of-run rows at simulated time `end_time` [s]; `out`
+    /// as in [`Self::record`]. Default: none.
+    fn finish(&mut self, _model: &Model, _end_time: f64, _out: &mut [TableBuffer]) {}
 
     /// A boxed copy (simulations are cloneable).
     fn clone_box(&self) -> Box<dyn Observer>;
