@@ -43,15 +43,15 @@ TIMEOUT_S = 120.0  # s: generous, for a loaded 2-core machine
 POLL_S = 5e-4  # s between two looks at the output folder
 #: The run killed: ball keys, 2 joints, 0.1 s, a frame every step.
 KILLED_RUN = ("--set", "pipe.joints=2", "--set", "simulation.duration=0.1", "--set", "simulation.output_interval=1e-4")
-#: What it writes: its 8 default tables and scene.toml.
-FILES_PER_RUN = 9
+#: What it writes: its 9 default tables and scene.toml.
+FILES_PER_RUN = 10
 TEMPORARY = re.compile(r"^\.(?P<final>.+)\.[0-9a-f]{8}\.tmp$")
 #: A run that diverges in the middle: the ball drop on a 100x stiffer ground at 1 ms RK4 steps
 #: diverges on landing, at t = 0.102 s of 0.2 s (step 102 of 200).
 DIVERGING = ("--set", "simulation.dt=1e-3", "--set", "contacts.0.normal.stiffness=1e10")
-#: A run for the small disk: energy.parquet (12 KiB) is written before keys.parquet (55 KiB), so a
+#: A run for the small disk: pairs.parquet (13 KiB) is written before keys.parquet (74 KiB), so a
 #: limit of 16 KiB per file, or a 64 KiB disk, fails the write with one table's temporary already written.
-BIG_RUN = ("--set", "pipe.joints=2", "--set", "simulation.duration=0.04", "--set", 'record.tables=["energy", "keys"]')
+BIG_RUN = ("--set", "pipe.joints=2", "--set", "simulation.duration=0.04", "--set", 'record.tables=["pairs", "keys"]')
 
 
 # --------------------------------------------------------------------------- helpers
@@ -317,7 +317,7 @@ def test_a_full_disk_is_exit_3_with_one_line_and_no_file(small_disk, tmp_path: P
     match = re.fullmatch(r"ballcage: error: cannot write (\S+): (.+)", lines[0])
     assert match and match.group(2) == reason, lines
     assert Path(match.group(1)) == out / "keys.parquet", lines
-    # energy.parquet's temporary was complete when keys.parquet's failed: it is removed, and never renamed
+    # pairs.parquet's temporary was complete when keys.parquet's failed: it is removed, and never renamed
     assert assert_no_partial_file(folder) == {"final": 0, "temporary": 0}
 
 
@@ -330,7 +330,7 @@ def test_a_full_disk_leaves_an_earlier_run_as_it_was(small_disk, tmp_path: Path)
     before = {p.name: p.read_bytes() for p in _files(out)}
     assert sorted(before) == ["energy.parquet", "scene.toml"]
     bigger = ["run", "--out", str(out), "--overwrite", "--quiet", *BIG_RUN]
-    assert _run_limited(shim, bigger, tmp_path / "bigger.log") == 3  # energy.parquet was written, not renamed
+    assert _run_limited(shim, bigger, tmp_path / "bigger.log") == 3  # pairs.parquet was written, not renamed
     assert _error_lines(tmp_path / "bigger.log")[0].endswith(reason)
     assert {p.name: p.read_bytes() for p in _files(out)} == before
     tables = 'record.tables=["bodies", "contacts", "energy", "summary"]'  # 20 KiB or more than the tmpfs holds

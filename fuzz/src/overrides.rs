@@ -12,7 +12,7 @@ use ballcage_core::Document;
 pub const BASES: [&str; 5] = [
     "kind = \"drill-pipe\"\n[pipe]\njoints = 1\n",
     "kind = \"drill-pipe\"\n[pipe]\njoints = 2\nhinge = \"ideal-cv\"\n",
-    "kind = \"drill-pipe\"\n[simulation]\nintegrator = \"rk4\"\ndt = 1e-7\noutput_interval = 1e-7\n[pipe]\njoints = 1\n",
+    "kind = \"drill-pipe\"\n[simulation]\nintegrator = \"rk4\"\ndt = 1e-7\noutput_interval = 1e-5\n[pipe]\njoints = 1\n",
     include_str!("../../examples/scenes/ball_drop.toml"),
     include_str!("../../examples/scenes/two_balls.toml"),
 ];
