@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Lists functions longer than a limit in the Rust core and the Python package.
+"""Lists functions longer than a limit in the Rust core (with ballcage-shapes) and the Python package.
 
 Usage: python3 scripts/long_functions.py [LIMIT]   (default 80 lines)
 
@@ -62,8 +62,9 @@ def python_functions(path: Path):
 def main() -> int:
     limit = int(sys.argv[1]) if len(sys.argv) > 1 else 80
     found = []
-    for path in sorted((ROOT / "crates/ballcage-core/src").rglob("*.rs")):
-        found += [(n, path, line, length) for n, line, length in rust_functions(path)]
+    for crate in ("crates/ballcage-core/src", "crates/ballcage-shapes/src"):
+        for path in sorted((ROOT / crate).rglob("*.rs")):
+            found += [(n, path, line, length) for n, line, length in rust_functions(path)]
     for path in sorted((ROOT / "python/ballcage").rglob("*.py")):
         found += [(n, path, line, length) for n, line, length in python_functions(path)]
     over = sorted((f for f in found if f[3] > limit), key=lambda f: -f[3])

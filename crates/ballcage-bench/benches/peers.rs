@@ -9,15 +9,18 @@
 //!   window too slow for a bench).
 //!
 //! ballcage runs its default integrator (SDIRK2); rapier its default solver
-//! (4 substeps) against a 64 × 180 facet bore mesh. Only the stepping is
-//! timed, not building either world. Criterion reports each time; after each
-//! pair the bench prints the ratio of the mean times it measured.
+//! (4 substeps) against a 64 × 180 facet bore mesh, and again against the
+//! exact tube (`Bore::Exact`: ballcage's `TubeInterior` through
+//! `ballcage_shapes::ShapeDispatcher`, 5 samples per link; issue 16). Only
+//! the stepping is timed, not building either world. Criterion reports each
+//! time; after each pair the bench prints the ratio of the mean times it
+//! measured.
 
 use std::cell::Cell;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use ballcage_bench::rapier_chain::{RapierChain, RapierOptions, paper_ideal_cv};
+use ballcage_bench::rapier_chain::{Bore, RapierChain, RapierOptions, paper_ideal_cv};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 /// Total time and iterations measured by one benchmark.
@@ -76,6 +79,23 @@ fn peers(c: &mut Criterion) {
                     black_box(chain.tube_normal_forces());
                 }
                 theirs.add(total, iters);
+                total
+            })
+        });
+        let exact = RapierOptions {
+            bore: Bore::Exact { samples: 5 },
+            ..RapierOptions::default()
+        };
+        g.bench_function(format!("rapier exact bore, dt {dt} s, {duration} s"), |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                for _ in 0..iters {
+                    let mut chain = RapierChain::from_scene(doc.scene(), &exact).expect("builds");
+                    let t0 = Instant::now();
+                    chain.advance_to(duration);
+                    total += t0.elapsed();
+                    black_box(chain.tube_normal_forces());
+                }
                 total
             })
         });

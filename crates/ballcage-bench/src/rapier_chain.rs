@@ -71,6 +71,32 @@
 //! tube, the mesh exists on the centreline's segments only: beyond the end
 //! planes there is no wall.
 //!
+//! # The exact bore
+//!
+//! With [`Bore::Exact`] the bore is instead ballcage's own tube, the parry
+//! shape `ballcage_shapes::TubeInterior` taken from the assembled model
+//! (the same object ballcage's contact evaluation uses), and the narrow
+//! phase is built with `ballcage_shapes::ShapeDispatcher` chained before
+//! parry's default dispatcher. The wall is then exact, and each link's
+//! contact with it is one manifold per sample along the link in contact (and
+//! per exact depth maximum between two samples), each with its own exact
+//! depth and normal: the line contact of ballcage's model without its
+//! one-force-per-patch reduction, which belongs to the penalty law. The
+//! difference between the two rapier runs is the faceted wall; between the
+//! exact-bore run and ballcage, rapier's solver (rigid contacts and joints,
+//! one Coulomb μ) against ballcage's model.
+//!
+//! rapier's contact clustering (merging a pair's manifolds of nearly parallel
+//! normals into at most four solver points per plane, `contact_clustering`)
+//! is off for the exact bore: it serves composite shapes with hundreds of
+//! manifolds, and with the few one-point manifolds of the exact bore the
+//! impulses rapier 0.35.3 writes back to the merged points did not add up to
+//! the load they carry (one link resting in a straight exact bore: 15 N
+//! summed against its 78.4 N weight, held all the same), whereas the plain
+//! manifolds' impulses sum to 78.39 N (the test
+//! `a_link_resting_in_a_straight_exact_bore_weighs_m_g`). The mesh keeps
+//! rapier's default (on), under which its own resting test gives m·g.
+//!
 //! # Contact and friction
 //!
 //! rapier's contacts are rigid, solved at velocity level with its soft-
@@ -98,11 +124,14 @@ use std::f64::consts::PI;
 
 use ballcage_core::Document;
 use ballcage_core::Simulation;
+use ballcage_core::geometry::Shape;
 use ballcage_core::model::SpinProfile;
 use ballcage_core::scene::{
     FeatureSpec, JointSpec, LoadSpec, MotionKind, ShapeSpec, TubeSegmentSpec,
 };
 use ballcage_core::{Scene, SceneError};
+use ballcage_shapes::ShapeDispatcher;
+use rapier3d_f64::parry::query::{DefaultQueryDispatcher, QueryDispatcher};
 use rapier3d_f64::prelude::*;
 
 /// Collision group of the link colliders.
@@ -155,10 +184,27 @@ impl BoreMesh {
     }
 }
 
+/// What the bore is in rapier.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Bore {
+    /// A triangle mesh of the wall ([`RapierOptions::mesh`]), rapier's own
+    /// contacts: faceted.
+    Mesh,
+    /// The exact tube (`ballcage_shapes::TubeInterior`) through
+    /// `ballcage_shapes::ShapeDispatcher`, `samples` points along each link
+    /// (≥ 2, rims included) locating its line contacts.
+    Exact {
+        /// Samples along a link's axis.
+        samples: u32,
+    },
+}
+
 /// How the rapier world is set up beyond what the scene says.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RapierOptions {
-    /// The bore mesh.
+    /// The bore: mesh or exact.
+    pub bore: Bore,
+    /// The bore mesh (with [`Bore::Mesh`]).
     pub mesh: BoreMesh,
     /// Coulomb coefficient of the link–bore contacts [–]; `None` takes the
     /// scene's link–tube friction law at the slip speed ω₀·r_link (the drive
@@ -173,6 +219,7 @@ pub struct RapierOptions {
 impl Default for RapierOptions {
     fn default() -> Self {
         Self {
+            bore: Bore::Mesh,
             mesh: BoreMesh::default(),
             friction: None,
             substeps: 4,
@@ -406,25 +453,8 @@ impl RapierChain {
 
         // The bore.
         let tube = &scene.bodies[tube_id];
-        let ShapeSpec::Tube {
-            inner_radius,
-            start,
-            direction,
-            segments,
-        } = &tube.shape
-        else {
-            unreachable!("found as a tube above")
-        };
-        let (vertices, indices) = bore_mesh(
-            *inner_radius,
-            v3(*start),
-            v3(*direction),
-            segments,
-            &options.mesh,
-        );
-        let triangles = indices.len();
-        let mesh = ColliderBuilder::trimesh_with_flags(vertices, indices, TriMeshFlags::ORIENTED)
-            .map_err(|e| err("bodies.tube", format!("bore mesh: {e:?}")))?
+        let (collider, triangles) = bore_collider(tube, &model.bodies[tube_id].shape, options)?;
+        let collider = collider
             .friction(friction)
             .collision_groups(InteractionGroups::new(
                 BORE,
@@ -432,7 +462,7 @@ impl RapierChain {
                 InteractionTestMode::And,
             ))
             .build();
-        let bore = colliders.insert_with_parent(mesh, handles[&tube.name], &mut bodies);
+        let bore = colliders.insert_with_parent(collider, handles[&tube.name], &mut bodies);
 
         // Hinges, with the bend limit of their neck–mouth pair if any.
         let mut bend_limit = None;
@@ -490,6 +520,8 @@ impl RapierChain {
             dt: scene.simulation.dt,
             length_unit: options.length_unit,
             contact_recycling: false,
+            // See "The exact bore" in the module doc.
+            contact_clustering: options.bore == Bore::Mesh,
             num_solver_iterations: options.substeps,
             ..IntegrationParameters::default()
         };
@@ -499,7 +531,12 @@ impl RapierChain {
             pipeline: PhysicsPipeline::new(),
             islands: IslandManager::new(),
             broad_phase: BroadPhaseBvh::new(),
-            narrow_phase: NarrowPhase::new(),
+            narrow_phase: match options.bore {
+                Bore::Mesh => NarrowPhase::new(),
+                Bore::Exact { samples } => NarrowPhase::with_query_dispatcher(
+                    ShapeDispatcher::with_samples(samples).chain(DefaultQueryDispatcher),
+                ),
+            },
             bodies,
             colliders,
             impulse_joints,
@@ -708,6 +745,46 @@ fn neck_limit(scene: &Scene, names: &[String; 2], anchors: &[[f64; 3]; 2]) -> Op
         let offset = (v3(*ring_centre) - v3(anchors[ring_side])).length();
         Some(articulation_limit(*cylinder_radius, *ring_radius, offset))
     })
+}
+
+/// The bore's collider (without friction and groups) and its triangle
+/// count (0 for the exact tube): the mesh of `tube`'s wall, or the exact
+/// tube of ballcage's assembled `shape` of it.
+fn bore_collider(
+    tube: &ballcage_core::scene::BodySpec,
+    shape: &Shape,
+    options: &RapierOptions,
+) -> Result<(ColliderBuilder, usize), SceneError> {
+    let ShapeSpec::Tube {
+        inner_radius,
+        start,
+        direction,
+        segments,
+    } = &tube.shape
+    else {
+        return Err(err("bodies", "the bore must be a tube"));
+    };
+    match (options.bore, shape) {
+        (Bore::Exact { .. }, Shape::Tube(path)) => Ok((
+            ColliderBuilder::new(SharedShape::new(path.interior().clone())).density(0.0),
+            0,
+        )),
+        (Bore::Exact { .. }, _) => Err(err("bodies", "the bore must be a tube")),
+        (Bore::Mesh, _) => {
+            let (vertices, indices) = bore_mesh(
+                *inner_radius,
+                v3(*start),
+                v3(*direction),
+                segments,
+                &options.mesh,
+            );
+            let triangles = indices.len();
+            let mesh =
+                ColliderBuilder::trimesh_with_flags(vertices, indices, TriMeshFlags::ORIENTED)
+                    .map_err(|e| err("bodies.tube", format!("bore mesh: {e:?}")))?;
+            Ok((mesh, triangles))
+        }
+    }
 }
 
 /// Vertices and triangles of the wall of a tube of inner radius `r` around
@@ -948,11 +1025,9 @@ mod tests {
         }
     }
 
-    /// One link lying in a straight, horizontal bore under gravity: the bore
-    /// carries its weight, m·g, once the link has settled (mean over
-    /// 0.2–0.5 s at 1 ms).
-    #[test]
-    fn a_link_resting_in_a_straight_bore_weighs_m_g() {
+    /// One link (8 kg, r = 43 mm) lying 14.8 mm below the axis of a straight,
+    /// horizontal bore of R = 58 mm, 1 m long, under gravity; 0.5 s at 1 ms.
+    fn resting_link() -> Scene {
         let text = r#"
 [simulation]
 duration = 0.5
@@ -975,7 +1050,15 @@ bodies = ["tube", "link"]
 normal = { law = "impact", stiffness = 1e5, exponent = 2.2, damping = 10.0, depth_max = 0.1, units = "N-mm-s" }
 friction = { law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 100.0, v_dynamic = 1000.0, units = "N-mm-s" }
 "#;
-        let scene = Scene::from_toml_str(text, &[]).expect("valid scene");
+        Scene::from_toml_str(text, &[]).expect("valid scene")
+    }
+
+    /// One link lying in a straight, horizontal bore under gravity: the bore
+    /// carries its weight, m·g, once the link has settled (mean over
+    /// 0.2–0.5 s at 1 ms).
+    #[test]
+    fn a_link_resting_in_a_straight_bore_weighs_m_g() {
+        let scene = resting_link();
         let mut chain = RapierChain::from_scene(&scene, &RapierOptions::default()).expect("builds");
         let mut mean = WindowMean::new(0.2, 0.5);
         while chain.time() < 0.5 - 1e-9 {
@@ -1006,5 +1089,71 @@ friction = { law = "adams", mu_static = 0.3, mu_dynamic = 0.1, v_static = 100.0,
         let z = chain.link_position(0)[2];
         let (around, _) = RapierOptions::default().mesh.chord_errors(0.058, 1.0);
         assert!((z + 0.015).abs() < around + 2e-4, "z = {z}");
+    }
+
+    /// The same link in the exact bore (ballcage's tube through
+    /// `ShapeDispatcher`): each of its five samples along the bottom has the
+    /// exact normal, straight up, so the contact forces' sum and resultant
+    /// are the same and carry m·g, and the link rests at the wall itself:
+    /// its axis R − r = 15 mm below the bore's, within rapier's allowed
+    /// penetration (0.001 × length_unit = 0.1 mm) and no chord error.
+    #[test]
+    fn a_link_resting_in_a_straight_exact_bore_weighs_m_g() {
+        let options = RapierOptions {
+            bore: Bore::Exact { samples: 5 },
+            ..RapierOptions::default()
+        };
+        let mut chain = RapierChain::from_scene(&resting_link(), &options).expect("builds");
+        assert_eq!(chain.triangles(), 0);
+        let mut mean = WindowMean::new(0.2, 0.5);
+        while chain.time() < 0.5 - 1e-9 {
+            chain.step();
+            let mut sample = chain.tube_normal_forces();
+            sample.extend(chain.tube_force_resultants()[0]);
+            mean.add(chain.time(), &sample);
+        }
+        let m = mean.means();
+        let w = 8.0 * 9.8;
+        assert!(
+            (m[3] - w).abs() < 0.005 * w,
+            "resultant {m:?} vs weight {w} N"
+        );
+        assert!(
+            (m[0] - m[3]).abs() < 1e-6 * w,
+            "sum {} vs resultant {}",
+            m[0],
+            m[3]
+        );
+        let z = chain.link_position(0)[2];
+        assert!((z + 0.015).abs() < 1e-4 + 1e-6, "z = {z}");
+    }
+
+    /// The paper's chain against the exact bore for 0.1 s from rest (at
+    /// 1 ms): rapier steps it through the custom dispatcher, the links
+    /// press on the wall, every force is finite and the total is of the
+    /// order of the chain's weight (the drive and load ramps have barely
+    /// begun: the moment is 1800·STEP(0.1 s) ≈ 0.26 kN·m).
+    #[test]
+    fn the_chain_in_the_exact_bore_produces_tube_forces() {
+        let scene = paper(&["simulation.duration=0.1"]);
+        let options = RapierOptions {
+            bore: Bore::Exact { samples: 5 },
+            ..RapierOptions::default()
+        };
+        let mut chain = RapierChain::from_scene(&scene, &options).expect("builds");
+        let mut mean = WindowMean::new(0.05, 0.1);
+        while chain.time() < 0.1 - 1e-9 {
+            chain.step();
+            mean.add(chain.time(), &chain.tube_normal_forces());
+        }
+        let f = mean.means();
+        assert_eq!(f.len(), 12);
+        assert!(f.iter().all(|x| x.is_finite() && *x >= 0.0), "{f:?}");
+        let total: f64 = f.iter().sum();
+        let weight = chain.moving_mass() * 9.8;
+        assert!(
+            total > 0.1 * weight && total < 10.0 * weight,
+            "{total} N against {weight} N"
+        );
     }
 }

@@ -12,153 +12,21 @@
 //! torque from where round-off puts its deepest sample, and a tilting link
 //! feels its centre of pressure move continuously toward the deeper end).
 //!
-//! At axial position s the link's surface point deepest in the wall is the
-//! rim point farthest from the centreline, so the depth profile is
-//! d(s) = |u(s)| + r − R_tube, u the axis point's offset from the centreline.
-//! Its maxima are the rims and the interior points where |u| stops growing:
-//! since u is perpendicular to the centreline at the nearest point,
-//! d|u|²/ds = 2 u·â exactly (â the link axis), so a maximum lies between two
-//! samples where u·â changes from positive to negative. There regula falsi
-//! (Illinois) on u·â finds it to round-off, so the largest penetration
-//! of a patch is exact, and a patch lying wholly between two samples (a
-//! straight link against the convex inner wall of a bend) is not missed.
-//! The `points` samples along the axis (rims included) locate the patches: a
-//! patch is a run of samples in contact, or such a hidden maximum.
+//! The geometry is `ballcage_shapes::line::line_patches` (its module doc
+//! derives how the deepest point between two samples is found exactly),
+//! the code parry and rapier use through `ballcage_shapes::ShapeDispatcher`;
+//! this function places the link in the tube's frame and the patches back
+//! in the world.
+
+use ballcage_shapes::Rod;
+use ballcage_shapes::line::{Ends, line_patches};
 
 use super::{ContactPoint, TubePath};
-use crate::math::{Quat, Vec3};
-
-/// A cylinder's surface in a tube, in the tube's frame.
-struct LinkInTube<'a> {
-    tube: &'a TubePath,
-    /// Centre of the cylinder [m].
-    centre: Vec3,
-    /// Unit axis.
-    axis: Vec3,
-    /// Cylinder radius [m].
-    radius: f64,
-}
-
-/// The deepest surface point of one axial station.
-struct Station {
-    /// Midpoint between the surfaces [m], tube frame.
-    point: Vec3,
-    /// Unit normal from the tube toward the link, tube frame.
-    normal: Vec3,
-    /// Penetration [m]; negative for a gap.
-    depth: f64,
-    /// u·â: positive while the offset from the centreline grows along the axis [m].
-    growth: f64,
-}
-
-impl LinkInTube<'_> {
-    /// The station at axial position `s` [m]. `None` where the axis is on
-    /// the centreline or the station is past the tube's open ends.
-    fn station(&self, s: f64) -> Option<Station> {
-        let q = self.centre + s * self.axis;
-        let c = self.tube.nearest(&q)?;
-        let u = q - c.point;
-        let across = u - u.dot(&self.axis) * self.axis;
-        let len = across.norm();
-        if len < 1e-15 {
-            return None;
-        }
-        let w = q + self.radius * across / len;
-        let cw = self.tube.nearest(&w)?;
-        let rw = w - cw.point;
-        let d = rw.norm();
-        if d < 1e-15 {
-            return None;
-        }
-        let depth = d - self.tube.inner_radius;
-        let out = rw / d;
-        Some(Station {
-            point: w - 0.5 * depth * out,
-            normal: -out,
-            depth,
-            growth: u.dot(&self.axis),
-        })
-    }
-
-    /// The axial position in `[a, b]` where the offset from the centreline
-    /// stops growing (u·â = 0, the depth's maximum), given u·â = `ga` > 0 at
-    /// `a` and `gb` ≤ 0 at `b`: the Illinois variant of regula falsi, which
-    /// converges superlinearly on this smooth root, to 1e-12 of the
-    /// positions. `None` if a station on the way does not exist.
-    fn deepest(&self, (mut a, mut ga): (f64, f64), (mut b, mut gb): (f64, f64)) -> Option<f64> {
-        let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
-        // Which end moved last: +1 for a, −1 for b.
-        let mut side = 0;
-        for _ in 0..100 {
-            if b - a <= tolerance {
-                break;
-            }
-            let x = (a * gb - b * ga) / (gb - ga);
-            let x = if x > a && x < b { x } else { 0.5 * (a + b) };
-            let gx = self.station(x)?.growth;
-            if gx > 0.0 {
-                (a, ga) = (x, gx);
-                if side == 1 {
-                    gb *= 0.5;
-                }
-                side = 1;
-            } else {
-                (b, gb) = (x, gx);
-                if side == -1 {
-                    ga *= 0.5;
-                }
-                side = -1;
-            }
-            if gx == 0.0 {
-                return Some(x);
-            }
-        }
-        Some(if ga.abs() < gb.abs() { a } else { b })
-    }
-}
-
-/// One contact patch under construction (tube frame).
-#[derive(Default)]
-struct Patch {
-    /// Largest penetration [m] and the sample nearest where it is.
-    depth: f64,
-    slot: usize,
-    /// Σ δ_k, Σ δ_k·p_k [m²] and Σ δ_k·n_k [m] over the patch's samples.
-    weight: f64,
-    point: Vec3,
-    normal: Vec3,
-}
-
-impl Patch {
-    /// Adds a sampled surface point of the patch.
-    fn add(&mut self, k: usize, st: &Station) {
-        self.deepen(k, st.depth);
-        self.weight += st.depth;
-        self.point += st.depth * st.point;
-        self.normal += st.depth * st.normal;
-    }
-
-    /// Raises the patch's largest penetration to `depth` if deeper.
-    fn deepen(&mut self, k: usize, depth: f64) {
-        if depth > self.depth {
-            self.depth = depth;
-            self.slot = k;
-        }
-    }
-
-    /// The patch's contact point, body frames mapped by the tube pose `pt`.
-    fn contact(&self, pt: (&Vec3, &Quat)) -> ContactPoint {
-        ContactPoint {
-            slot: self.slot as u32,
-            point: pt.0 + pt.1 * (self.point / self.weight),
-            normal: pt.1 * self.normal.normalize(),
-            depth: self.depth,
-        }
-    }
-}
+use crate::math::{Quat, Vec3, from_glam, to_glam};
 
 /// Contact points of a cylinder (`radius`, `half_length`, axis along its
-/// body x) at pose `pc` inside tube `t` at pose `pt`: one per patch.
+/// body x) at pose `pc` inside tube `t` at pose `pt`: one per patch, from
+/// `points` samples along the axis (rims included) that locate the patches.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn cylinder_tube(
     t: &TubePath,
@@ -170,75 +38,20 @@ pub(super) fn cylinder_tube(
     out: &mut Vec<ContactPoint>,
 ) {
     let inv = pt.1.inverse();
-    let link = LinkInTube {
-        tube: t,
-        centre: inv * (pc.0 - pt.0),
-        axis: inv * (pc.1 * Vec3::x()),
+    let rod = Rod {
+        centre: to_glam(&(inv * (pc.0 - pt.0))),
+        axis: to_glam(&(inv * (pc.1 * Vec3::x()))),
+        half_length,
         radius,
     };
-    let n = points.max(2) as usize;
-    let s = |k: usize| -half_length + 2.0 * half_length * k as f64 / (n - 1) as f64;
-    let touching = |st: &Option<Station>| st.as_ref().is_some_and(|st| st.depth > 0.0);
-    let mut open: Option<Patch> = None;
-    // A hidden maximum just before a patch opens belongs to it.
-    let mut pending: Option<(usize, f64)> = None;
-    // Stations k and k + 1 only: no allocation per evaluation.
-    let mut here = link.station(s(0));
-    for k in 0..n {
-        let next = if k + 1 < n {
-            link.station(s(k + 1))
-        } else {
-            None
-        };
-        match &here {
-            Some(st) if st.depth > 0.0 => {
-                let p = open.get_or_insert_with(Patch::default);
-                if let Some((j, d)) = pending.take() {
-                    p.deepen(j, d);
-                }
-                p.add(k, st);
-            }
-            _ => {
-                if let Some(p) = open.take() {
-                    out.push(p.contact(pt));
-                }
-            }
-        }
-        if let Some((x, peak)) = interior_maximum(&link, (s(k), &here), (s(k + 1), &next)) {
-            let j = if x - s(k) < s(k + 1) - x { k } else { k + 1 };
-            match (&mut open, touching(&next)) {
-                (Some(p), _) => p.deepen(j, peak.depth),
-                (None, true) => pending = Some((j, peak.depth)),
-                (None, false) => {
-                    let mut p = Patch::default();
-                    p.add(j, &peak);
-                    out.push(p.contact(pt));
-                }
-            }
-        }
-        here = next;
-    }
-    if let Some(p) = open {
-        out.push(p.contact(pt));
-    }
-}
-
-/// The interior depth maximum between two neighbouring samples (axial
-/// position [m] and station each), if one lies there and is in contact:
-/// its position [m] and station.
-fn interior_maximum(
-    link: &LinkInTube<'_>,
-    (sa, a): (f64, &Option<Station>),
-    (sb, b): (f64, &Option<Station>),
-) -> Option<(f64, Station)> {
-    let (a, b) = (a.as_ref()?, b.as_ref()?);
-    if !(a.growth > 0.0 && b.growth <= 0.0) {
-        return None;
-    }
-    let x = link.deepest((sa, a.growth), (sb, b.growth))?;
-    link.station(x)
-        .filter(|st| st.depth > 0.0)
-        .map(|st| (x, st))
+    line_patches(t.interior(), &rod, Ends::Flat, points, 0.0, &mut |c| {
+        out.push(ContactPoint {
+            slot: c.feature,
+            point: pt.0 + pt.1 * from_glam(c.point),
+            normal: pt.1 * from_glam(c.normal),
+            depth: c.depth,
+        })
+    });
 }
 
 #[cfg(test)]

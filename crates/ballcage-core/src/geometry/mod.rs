@@ -16,6 +16,14 @@
 //! | cylinder–tube | analytic line contact (`line.rs`): one point per contact patch at its deepest penetration; `points` samples along the axis locate the patches |
 //! | ball–tube | analytic: distance to the centreline |
 //! | declared features (groove flank, window, spherical cavity, ring–cylinder) | analytic, in the bodies' frames (`ring.rs` for a neck through a ring) |
+//!
+//! The tube, the groove flank (`TorusBall`), the window (`SlotBall`) and the
+//! cavity (`CavitySphere`) are computed by the crate `ballcage-shapes`
+//! (`TubeInterior`, `GrooveFlank`, `WindowSlot`, `SphericalCavity`), whose
+//! types are also parry shapes with a query dispatcher for rapier: one
+//! geometry code path for ballcage, parry and rapier. Here the bodies are
+//! placed in the feature's frame and the contact mapped back; the engine's
+//! nalgebra vectors and parry's glam vectors convert component by component.
 
 mod line;
 mod ring;
@@ -25,6 +33,7 @@ pub use ring::RingCylinder;
 
 pub use tube::{CentrelinePoint, TubePath, TubeSegment};
 
+use ballcage_shapes::{GrooveFlank, LocalContact, SphericalCavity, WindowSlot};
 use parry3d_f64::query;
 use parry3d_f64::shape::{Ball, Cuboid, HalfSpace};
 
@@ -60,7 +69,7 @@ impl Shape {
             Self::Cuboid(c) => c.half_extents.min_element(),
             Self::HalfSpace(_) => f64::INFINITY,
             Self::Cylinder { radius, .. } => *radius,
-            Self::Tube(t) => t.inner_radius,
+            Self::Tube(t) => t.inner_radius(),
         }
     }
 
@@ -346,17 +355,15 @@ fn cuboid_half_space(
     }
 }
 
-/// Wall contact of a surface point `w` in tube frame; normal from the tube toward the body (inward).
-fn wall_contact(t: &TubePath, w: &Vec3) -> Option<(Vec3, Vec3, f64)> {
-    let c = t.nearest(w)?;
-    let r = w - c.point;
-    let d = r.norm();
-    let depth = d - t.inner_radius;
-    if depth <= 0.0 || d < 1e-15 {
-        return None;
-    }
-    let out = r / d;
-    Some((w - 0.5 * depth * out, -out, depth))
+/// A contact in the frame of body a (pose `pa`) as a world contact point,
+/// if the surfaces overlap.
+fn placed(c: LocalContact, pa: (&Vec3, &Quat)) -> Option<ContactPoint> {
+    (c.depth > 0.0).then(|| ContactPoint {
+        slot: c.feature,
+        point: pa.0 + pa.1 * from_glam(c.point),
+        normal: pa.1 * from_glam(c.normal),
+        depth: c.depth,
+    })
 }
 
 fn ball_tube(
@@ -366,22 +373,9 @@ fn ball_tube(
     pb: (&Vec3, &Quat),
     out: &mut Vec<ContactPoint>,
 ) {
-    let inv = pt.1.inverse();
-    let centre = inv * (pb.0 - pt.0);
-    let Some(c) = t.nearest(&centre) else { return };
-    let r = centre - c.point;
-    let d = r.norm();
-    if d < 1e-15 {
-        return;
-    }
-    let w = centre + radius * r / d;
-    if let Some((p, nrm, depth)) = wall_contact(t, &w) {
-        out.push(ContactPoint {
-            slot: 0,
-            point: pt.0 + pt.1 * p,
-            normal: pt.1 * nrm,
-            depth,
-        });
+    let centre = pt.1.inverse() * (pb.0 - pt.0);
+    if let Some(c) = t.interior().ball_contact(to_glam(&centre), radius) {
+        out.extend(placed(c, pt));
     }
 }
 
@@ -397,30 +391,16 @@ fn torus_ball(
     pb: (&Vec3, &Quat),
     out: &mut Vec<ContactPoint>,
 ) {
+    let flank = GrooveFlank {
+        centre: to_glam(centre),
+        axis: to_glam(axis),
+        core_radius,
+        tube_radius,
+    };
     let p = pa.1.inverse() * (pb.0 - pa.0);
-    let r = p - centre;
-    let in_plane = r - r.dot(axis) * axis;
-    let len = in_plane.norm();
-    if len < 1e-15 {
-        return;
+    if let Some(c) = flank.ball_contact(to_glam(&p), ball_radius) {
+        out.extend(placed(c, pa));
     }
-    let q = centre + core_radius * in_plane / len;
-    let to_core = q - p;
-    let d = to_core.norm();
-    let depth = d + ball_radius - tube_radius;
-    if depth <= 0.0 || d < 1e-15 {
-        return;
-    }
-    // The wall pushes the ball back toward the core circle.
-    let n = to_core / d;
-    let ball_surface = p - ball_radius * n;
-    let point = ball_surface + 0.5 * depth * n;
-    out.push(ContactPoint {
-        slot: 0,
-        point: pa.0 + pa.1 * point,
-        normal: pa.1 * n,
-        depth,
-    });
 }
 
 /// Ball (centre p, world) between two parallel planes of body a.
@@ -433,20 +413,13 @@ fn slot_ball(
     pb: (&Vec3, &Quat),
     out: &mut Vec<ContactPoint>,
 ) {
+    let slot = WindowSlot {
+        centre: to_glam(centre),
+        normal: to_glam(normal),
+        half_width,
+    };
     let p = pa.1.inverse() * (pb.0 - pa.0);
-    let u = (p - centre).dot(normal);
-    let depth = ball_radius + u.abs() - half_width;
-    if depth <= 0.0 {
-        return;
-    }
-    let side = if u >= 0.0 { 1.0 } else { -1.0 };
-    let point = p + side * (ball_radius - 0.5 * depth) * normal;
-    out.push(ContactPoint {
-        slot: 0,
-        point: pa.0 + pa.1 * point,
-        normal: pa.1 * (-side * normal),
-        depth,
-    });
+    out.extend(placed(slot.ball_contact(to_glam(&p), ball_radius), pa));
 }
 
 /// Sphere (centre ob, world) inside a cavity (centre oa, world).
@@ -457,20 +430,18 @@ fn cavity_sphere(
     sphere_radius: f64,
     out: &mut Vec<ContactPoint>,
 ) {
-    let r = ob - oa;
-    let d = r.norm();
-    let depth = d + sphere_radius - cavity_radius;
-    if depth <= 0.0 || d < 1e-15 {
-        return;
+    let cavity = SphericalCavity::new(to_glam(oa), cavity_radius);
+    // Already in the world frame.
+    if let Some(c) = cavity.sphere_contact(to_glam(ob), sphere_radius)
+        && c.depth > 0.0
+    {
+        out.push(ContactPoint {
+            slot: c.feature,
+            point: from_glam(c.point),
+            normal: from_glam(c.normal),
+            depth: c.depth,
+        });
     }
-    let u = r / d;
-    let point = ob + (sphere_radius - 0.5 * depth) * u;
-    out.push(ContactPoint {
-        slot: 0,
-        point,
-        normal: -u,
-        depth,
-    });
 }
 
 #[cfg(test)]

@@ -1,0 +1,448 @@
+//! A cylinder or capsule inside a lumen around a centreline (a tube, or the
+//! tube of a torus): a line contact, found exactly at its deepest points.
+//!
+//! At axial position s the rod's surface point deepest in the wall is, for a
+//! cylinder, the rim point farthest from the centreline; for a capsule, the
+//! point of the sphere at the axis point along the offset from the
+//! centreline. So the depth profile is d(s) = |u(s)| + r − R_wall to first
+//! order (a capsule: exactly), u the axis point's offset from the
+//! centreline. Its maxima are the ends and the interior points where |u|
+//! stops growing: since u is perpendicular to the centreline at the nearest
+//! point, d|u|²/ds = 2 u·â exactly (â the rod axis), so a maximum lies between
+//! two samples where u·â changes from positive to negative. There regula
+//! falsi (Illinois) on u·â finds it to round-off, so the largest penetration
+//! is exact, and a contact lying wholly between two samples (a straight link
+//! against the convex inner wall of a bend) is not missed.
+//!
+//! Two reductions of the same walk along the axis:
+//! - [`line_patches`]: one contact per patch (a run of samples in contact,
+//!   or such a hidden maximum) at its largest penetration, acting at the
+//!   patch's centre of pressure: MSC Adams' convention, which ballcage's
+//!   penalty law follows, so the force does not depend on the sampling;
+//! - [`line_stations`]: every sample in contact and every hidden maximum,
+//!   each with its own exact depth and normal: what a rigid-contact solver
+//!   (rapier) wants for a line contact.
+
+use parry3d_f64::math::Vector;
+
+use crate::contact::{LocalContact, Rod, unit};
+use crate::tube::CentrelinePoint;
+
+/// A lumen around a centreline: the wall is `wall_radius` from it.
+pub trait Centreline {
+    /// Nearest centreline point to `q`, or `None` where there is no wall
+    /// (past an open end, or on a torus's axis).
+    fn nearest(&self, q: Vector) -> Option<CentrelinePoint>;
+    /// Distance from the centreline to the wall [m].
+    fn wall_radius(&self) -> f64;
+}
+
+/// The ends of a rod.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ends {
+    /// A cylinder: flat ends, sharp rims.
+    Flat,
+    /// A capsule: hemispherical caps.
+    Round,
+}
+
+/// A rod's surface in a lumen, in the lumen's frame.
+struct RodInLumen<'a, L: ?Sized> {
+    lumen: &'a L,
+    rod: Rod,
+    ends: Ends,
+}
+
+/// The deepest surface point of one axial station.
+struct Station {
+    /// Midpoint between the surfaces [m].
+    point: Vector,
+    /// Unit normal from the wall toward the rod.
+    normal: Vector,
+    /// Penetration [m]; negative for a gap.
+    depth: f64,
+    /// u·â: positive while the offset from the centreline grows along the axis [m].
+    growth: f64,
+}
+
+impl Station {
+    fn contact(&self, feature: usize) -> LocalContact {
+        LocalContact {
+            point: self.point,
+            normal: self.normal,
+            depth: self.depth,
+            feature: feature as u32,
+        }
+    }
+}
+
+impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
+    /// The station at axial position `s` [m]. `None` where the axis is on
+    /// the centreline or the station is past the lumen's open ends.
+    fn station(&self, s: f64) -> Option<Station> {
+        let q = self.rod.at(s);
+        let c = self.lumen.nearest(q)?;
+        let u = q - c.point;
+        let growth = u.dot(self.rod.axis);
+        if self.ends == Ends::Round {
+            return self.ball_station(q, u, growth);
+        }
+        let across = u - growth * self.rod.axis;
+        let len = across.length();
+        if len < 1e-15 {
+            return None;
+        }
+        let w = q + self.rod.radius * across / len;
+        let cw = self.lumen.nearest(w)?;
+        let rw = w - cw.point;
+        let d = rw.length();
+        if d < 1e-15 {
+            return None;
+        }
+        let depth = d - self.lumen.wall_radius();
+        let out = rw / d;
+        Some(Station {
+            point: w - 0.5 * depth * out,
+            normal: -out,
+            depth,
+            growth,
+        })
+    }
+
+    /// A capsule's station: the sphere about the axis point `q` whose offset
+    /// from the centreline is `u`: δ = |u| + r − R.
+    fn ball_station(&self, q: Vector, u: Vector, growth: f64) -> Option<Station> {
+        let len = u.length();
+        if len < 1e-15 {
+            return None;
+        }
+        let out = u / len;
+        let depth = len + self.rod.radius - self.lumen.wall_radius();
+        let w = q + self.rod.radius * out;
+        Some(Station {
+            point: w - 0.5 * depth * out,
+            normal: -out,
+            depth,
+            growth,
+        })
+    }
+
+    /// The axial position in `[a, b]` where the offset from the centreline
+    /// stops growing (u·â = 0, the depth's maximum), given u·â = `ga` > 0 at
+    /// `a` and `gb` ≤ 0 at `b`: the Illinois variant of regula falsi, which
+    /// converges superlinearly on this smooth root, to 1e-12 of the
+    /// positions. `None` if a station on the way does not exist.
+    fn deepest(&self, (mut a, mut ga): (f64, f64), (mut b, mut gb): (f64, f64)) -> Option<f64> {
+        let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
+        // Which end moved last: +1 for a, −1 for b.
+        let mut side = 0;
+        for _ in 0..100 {
+            if b - a <= tolerance {
+                break;
+            }
+            let x = (a * gb - b * ga) / (gb - ga);
+            let x = if x > a && x < b { x } else { 0.5 * (a + b) };
+            let gx = self.station(x)?.growth;
+            if gx > 0.0 {
+                (a, ga) = (x, gx);
+                if side == 1 {
+                    gb *= 0.5;
+                }
+                side = 1;
+            } else {
+                (b, gb) = (x, gx);
+                if side == -1 {
+                    ga *= 0.5;
+                }
+                side = -1;
+            }
+            if gx == 0.0 {
+                return Some(x);
+            }
+        }
+        Some(if ga.abs() < gb.abs() { a } else { b })
+    }
+
+    /// The interior depth maximum between two neighbouring samples (axial
+    /// position [m] and station each), if one lies there and is deeper than
+    /// `threshold`: its position [m] and station.
+    fn interior_maximum(
+        &self,
+        (sa, a): (f64, &Option<Station>),
+        (sb, b): (f64, &Option<Station>),
+        threshold: f64,
+    ) -> Option<(f64, Station)> {
+        let (a, b) = (a.as_ref()?, b.as_ref()?);
+        if !(a.growth > 0.0 && b.growth <= 0.0) {
+            return None;
+        }
+        let x = self.deepest((sa, a.growth), (sb, b.growth))?;
+        self.station(x)
+            .filter(|st| st.depth > threshold)
+            .map(|st| (x, st))
+    }
+}
+
+/// What the walk along the axis finds, in order.
+enum Event<'a> {
+    /// Sample `k`, in contact (deeper than the threshold) or not.
+    Sample(usize, Option<&'a Station>),
+    /// A hidden maximum between samples `k` and `k + 1`, nearest to sample
+    /// `j`; whether sample `k + 1` is in contact; the deeper of the two
+    /// samples' depths [m] (−∞ where a station does not exist).
+    Peak {
+        k: usize,
+        j: usize,
+        station: Station,
+        next_touching: bool,
+        neighbours: f64,
+    },
+}
+
+/// Walks `samples` (≥ 2) evenly spaced axial positions of `rod` from end to
+/// end, reporting each sample and each interior maximum deeper than
+/// `threshold` [m] between two samples. Two stations at a time: no allocation.
+fn walk<L: Centreline + ?Sized>(
+    lumen: &L,
+    rod: &Rod,
+    ends: Ends,
+    samples: u32,
+    threshold: f64,
+    visit: &mut impl FnMut(Event<'_>),
+) {
+    let link = RodInLumen {
+        lumen,
+        rod: *rod,
+        ends,
+    };
+    let n = samples.max(2) as usize;
+    let h = rod.half_length;
+    let s = |k: usize| -h + 2.0 * h * k as f64 / (n - 1) as f64;
+    let touching = |st: &Option<Station>| st.as_ref().is_some_and(|st| st.depth > threshold);
+    let mut here = link.station(s(0));
+    for k in 0..n {
+        let next = if k + 1 < n {
+            link.station(s(k + 1))
+        } else {
+            None
+        };
+        visit(Event::Sample(
+            k,
+            here.as_ref().filter(|st| st.depth > threshold),
+        ));
+        if let Some((x, peak)) = link.interior_maximum((s(k), &here), (s(k + 1), &next), threshold)
+        {
+            let j = if x - s(k) < s(k + 1) - x { k } else { k + 1 };
+            let depth = |st: &Option<Station>| st.as_ref().map_or(f64::NEG_INFINITY, |st| st.depth);
+            visit(Event::Peak {
+                k,
+                j,
+                station: peak,
+                next_touching: touching(&next),
+                neighbours: depth(&here).max(depth(&next)),
+            });
+        }
+        here = next;
+    }
+}
+
+/// One contact patch under construction.
+struct Patch {
+    /// Largest penetration [m] and the sample nearest where it is.
+    depth: f64,
+    slot: usize,
+    /// Σ w_k, Σ w_k·p_k [m²] and Σ w_k·n_k [m] over the patch's samples, with
+    /// weights w_k = δ_k − threshold > 0.
+    weight: f64,
+    point: Vector,
+    normal: Vector,
+}
+
+impl Patch {
+    fn new() -> Self {
+        Self {
+            depth: f64::NEG_INFINITY,
+            slot: 0,
+            weight: 0.0,
+            point: Vector::ZERO,
+            normal: Vector::ZERO,
+        }
+    }
+
+    /// Adds a sampled surface point of the patch.
+    fn add(&mut self, k: usize, st: &Station, threshold: f64) {
+        self.deepen(k, st.depth);
+        let w = st.depth - threshold;
+        self.weight += w;
+        self.point += w * st.point;
+        self.normal += w * st.normal;
+    }
+
+    /// Raises the patch's largest penetration to `depth` if deeper.
+    fn deepen(&mut self, k: usize, depth: f64) {
+        if depth > self.depth {
+            self.depth = depth;
+            self.slot = k;
+        }
+    }
+
+    /// The patch's contact: its largest penetration at its centre of
+    /// pressure, along its weighted mean normal.
+    fn contact(&self) -> LocalContact {
+        LocalContact {
+            point: self.point / self.weight,
+            normal: unit(self.normal),
+            depth: self.depth,
+            feature: self.slot as u32,
+        }
+    }
+}
+
+/// The contacts of `rod` (flat or round `ends`) inside `lumen`, one per
+/// contact patch (see the module doc), in the lumen's frame, from the
+/// `samples` (≥ 2, ends included) that locate the patches. A point is in
+/// contact when deeper than `threshold` [m] (0 for touching only; −p to
+/// report gaps up to p). The centre of pressure weights each sample by its
+/// depth beyond the threshold. `feature` is the sample nearest the largest
+/// penetration.
+pub fn line_patches<L: Centreline + ?Sized>(
+    lumen: &L,
+    rod: &Rod,
+    ends: Ends,
+    samples: u32,
+    threshold: f64,
+    emit: &mut impl FnMut(LocalContact),
+) {
+    let mut open: Option<Patch> = None;
+    // A hidden maximum just before a patch opens belongs to it.
+    let mut pending: Option<(usize, f64)> = None;
+    walk(lumen, rod, ends, samples, threshold, &mut |e| match e {
+        Event::Sample(k, Some(st)) => {
+            let p = open.get_or_insert_with(Patch::new);
+            if let Some((j, d)) = pending.take() {
+                p.deepen(j, d);
+            }
+            p.add(k, st, threshold);
+        }
+        Event::Sample(_, None) => {
+            if let Some(p) = open.take() {
+                emit(p.contact());
+            }
+        }
+        Event::Peak {
+            j,
+            station,
+            next_touching,
+            ..
+        } => match (&mut open, next_touching) {
+            (Some(p), _) => p.deepen(j, station.depth),
+            (None, true) => pending = Some((j, station.depth)),
+            (None, false) => {
+                let mut p = Patch::new();
+                p.add(j, &station, threshold);
+                emit(p.contact());
+            }
+        },
+    });
+    if let Some(p) = open {
+        emit(p.contact());
+    }
+}
+
+/// The contacts of `rod` inside `lumen`, one per sample deeper than
+/// `threshold` [m] (`feature` = its index k) and one per hidden maximum
+/// between samples k and k + 1 (`feature` = `samples` + k), each with its
+/// own exact depth and normal, in the lumen's frame. A maximum no deeper
+/// than its two samples by 1e-12 m is left out: there the depth is flat (a
+/// rod lying along a straight wall, where round-off alone makes the offset
+/// "stop growing" between samples) and the samples already carry it.
+pub fn line_stations<L: Centreline + ?Sized>(
+    lumen: &L,
+    rod: &Rod,
+    ends: Ends,
+    samples: u32,
+    threshold: f64,
+    emit: &mut impl FnMut(LocalContact),
+) {
+    let n = samples.max(2) as usize;
+    walk(lumen, rod, ends, samples, threshold, &mut |e| match e {
+        Event::Sample(k, Some(st)) => emit(st.contact(k)),
+        Event::Sample(_, None) => {}
+        Event::Peak {
+            k,
+            station,
+            neighbours,
+            ..
+        } => {
+            if station.depth > neighbours + 1e-12 {
+                emit(station.contact(n + k))
+            }
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tube::{TubeInterior, TubeSegment};
+
+    fn straight() -> TubeInterior {
+        TubeInterior::new(
+            0.058,
+            Vector::new(-1.0, 0.0, 0.0),
+            Vector::X,
+            &[TubeSegment::Straight { length: 2.0 }],
+        )
+    }
+
+    fn rod(centre: Vector, axis: Vector) -> Rod {
+        Rod {
+            centre,
+            axis,
+            half_length: 0.1,
+            radius: 0.043,
+        }
+    }
+
+    fn all(f: impl FnOnce(&mut dyn FnMut(LocalContact))) -> Vec<LocalContact> {
+        let mut out = vec![];
+        f(&mut |c| out.push(c));
+        out
+    }
+
+    #[test]
+    fn a_capsule_tilted_in_a_straight_tube_touches_with_its_lower_cap() {
+        // Axis (cos θ, 0, −sin θ), centre h = 14.1 mm below the tube's axis
+        // (the x axis): the segment end at s = +0.1 m is h + 0.1·sin θ below
+        // it, its sphere reaches that + r from the axis, so
+        // δ = h + 0.1·sin θ + 0.043 − 0.058 = 0.098 mm, normal +z (toward the
+        // axis). The offset grows all along the axis (u·â = |u|·sin θ > 0), so
+        // the end is the only maximum, and the sample at s = 0.05 m is
+        // 0.5 mm clear: one patch, at the last sample.
+        let th: f64 = 0.01;
+        let axis = Vector::new(th.cos(), 0.0, -th.sin());
+        let r = rod(Vector::new(0.0, 0.0, -0.0141), axis);
+        let out = all(|e| line_patches(&straight(), &r, Ends::Round, 5, 0.0, &mut |c| e(c)));
+        assert_eq!(out.len(), 1);
+        let expect = 0.0141 + 0.1 * th.sin() + 0.043 - 0.058;
+        assert!((out[0].depth - expect).abs() < 1e-14, "{}", out[0].depth);
+        assert!((out[0].normal - Vector::Z).length() < 1e-12);
+        assert_eq!(out[0].feature, 4);
+    }
+
+    #[test]
+    fn stations_report_every_sample_in_contact_with_its_own_depth() {
+        // A cylinder lying 0.1 mm into the bottom all along: five samples,
+        // each 0.1 mm deep; with a threshold of −1 mm, also a cylinder lying
+        // 0.5 mm clear of the wall reports five points at δ = −0.5 mm.
+        for (z, depth) in [(-0.0151, 1e-4), (-0.0145, -5e-4)] {
+            let r = rod(Vector::new(0.0, 0.0, z), Vector::X);
+            let out = all(|e| line_stations(&straight(), &r, Ends::Flat, 5, -1e-3, &mut |c| e(c)));
+            assert_eq!(out.len(), 5);
+            for (k, c) in out.iter().enumerate() {
+                assert_eq!(c.feature, k as u32);
+                assert!((c.depth - depth).abs() < 1e-14);
+            }
+        }
+    }
+}
