@@ -24,13 +24,13 @@ python3 -m pip install --quiet --no-deps --target target/ballcage-test-panic tar
 export BALLCAGE_TEST_PANIC_PATH="$PWD/target/ballcage-test-panic"
 echo "== stubtest (python/ballcage/_native.pyi against the built module)"
 python3 -m mypy.stubtest ballcage._native --mypy-config-file pyproject.toml
-echo "== chromium (tests/test_view.py loads the 3D view page in a real headless browser)"
-if ! command -v chromium >/dev/null; then
+echo "== chromium and ffmpeg (tests/test_view.py: the 3D view page in a real headless browser, the MP4 export)"
+if ! command -v chromium >/dev/null || ! command -v ffmpeg >/dev/null; then
   as_root=""
   [ "$(id -u)" -eq 0 ] || as_root="sudo -n"
-  if ! { $as_root apt-get update -qq && $as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium; }; then
-    echo "could not install Debian's chromium as $(id -un): the browser tests of tests/test_view.py" \
-      "will be skipped, each saying so (as root: apt-get install chromium)"
+  if ! { $as_root apt-get update -qq && $as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium ffmpeg; }; then
+    echo "could not install Debian's chromium and ffmpeg as $(id -un): the browser and MP4 tests of" \
+      "tests/test_view.py will be skipped, each saying so (as root: apt-get install chromium ffmpeg)"
   fi
 fi
 echo "== pytest"

@@ -2,9 +2,10 @@
 //! drives and loads put in is what the bodies gained plus what friction,
 //! contact damping and the penalty joints took (docs/engine.md, "Energy").
 
-use ballcage_core::record::TableBuffer;
-use ballcage_core::record::{ColumnData, Recording};
-use ballcage_core::{Document, Scene, Simulation};
+mod common;
+
+use ballcage_core::Document;
+use ballcage_core::record::{ColumnData, Recording, TableBuffer};
 
 fn column<'a>(rec: &'a Recording, table: &str, name: &str) -> &'a [f64] {
     let t: &TableBuffer = rec
@@ -57,8 +58,7 @@ friction = {{ law = "tanh", mu = 0.3, v_ref = 1e-4 }}
 "#,
         z = r - rest
     );
-    let scene = Scene::from_toml_str(&text, &[]).unwrap();
-    let mut sim = Simulation::new(&scene).unwrap();
+    let mut sim = common::sim(&text);
     while !sim.is_done() {
         sim.step().expect("stable");
     }

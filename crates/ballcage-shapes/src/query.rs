@@ -330,20 +330,7 @@ impl RayCast for SphericalCavity {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tube::TubeSegment;
-
-    fn paper_tube() -> TubeInterior {
-        TubeInterior::new(
-            0.058,
-            Vector::ZERO,
-            Vector::new(0.0, 0.0, -1.0),
-            &[TubeSegment::Arc {
-                radius: 1.5,
-                angle: 90f64.to_radians(),
-                bend: Vector::X,
-            }],
-        )
-    }
+    use crate::tube::tests::paper_tube;
 
     /// A point of the lumen projects radially onto the wall; a point of
     /// the wall is inside the solid.

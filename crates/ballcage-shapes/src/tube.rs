@@ -377,7 +377,7 @@ pub(crate) fn nearest_on_segment(seg: &Segment, q: Vector) -> CentrelinePoint {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn close(a: Vector, b: Vector, tol: f64) -> bool {
@@ -385,7 +385,7 @@ mod tests {
     }
 
     /// The paper's guide tube: down from the origin, bending toward +x at R = 1.5 m over 90°.
-    fn paper_tube() -> TubeInterior {
+    pub(crate) fn paper_tube() -> TubeInterior {
         TubeInterior::new(
             0.058,
             Vector::ZERO,

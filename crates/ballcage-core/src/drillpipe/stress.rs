@@ -14,11 +14,15 @@
 
 use super::layout::{Feature, Layout};
 use super::spec::{DrillPipeSpec, SolidSpec};
+use super::tables::{FEATURE, HINGE, KEY, LINK, PAIR, PAIR_ID, pair_cells};
 use crate::dynamics::ContactEval;
 use crate::force::hertz::{Elliptical, HertzContact, Line, effective_modulus};
 use crate::geometry::{PairGeometry, Shape};
 use crate::math::Vec3;
 use crate::model::{ContactPair, Model, State};
+use crate::record::{Cell, ColumnDef, ColumnKind, TableBuffer, TableDef, col};
+
+use ColumnKind::{F64, OptF64};
 
 /// How a pair's Hertz patch is found.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -301,43 +305,14 @@ impl PairWear {
     }
 }
 
-use crate::record::{Cell, ColumnDef, ColumnKind, Dictionary, TableBuffer, TableDef, col};
-
-use ColumnKind::{F64, Name, OptF64, OptU32, U32};
-
 /// Columns of the `wear` table (drill pipe): one row per contact pair, at the end of the run.
 const WEAR_COLUMNS: &[ColumnDef] = &[
-    col(
-        "pair_id",
-        U32,
-        "",
-        "contact pair index (the pairs table's pair_id)",
-    ),
-    col("pair", Name(Dictionary::Pairs), "", "contact pair name"),
-    col(
-        "feature",
-        Name(Dictionary::Labels(Feature::LABELS)),
-        "",
-        "what the pair touches, as in the pairs table",
-    ),
-    col(
-        "link",
-        OptU32,
-        "",
-        "link number (tube pairs; null otherwise)",
-    ),
-    col(
-        "hinge",
-        OptU32,
-        "",
-        "hinge number (joint pairs; null otherwise)",
-    ),
-    col(
-        "key",
-        OptU32,
-        "",
-        "ball key number (key pairs; null otherwise)",
-    ),
+    PAIR_ID,
+    PAIR,
+    FEATURE,
+    LINK,
+    HINGE,
+    KEY,
     col(
         "window_start",
         F64,
@@ -447,13 +422,14 @@ pub fn wear_rows(
         let rate = s.has_model().then(|| k_h * w.pressure_sliding / span);
         let hours = rate.filter(|r| *r > 0.0).map(|r| 1e-4 / r / 3600.0);
         let peak = w.peak;
+        let [id, name, feature, link, hinge, key] = pair_cells(k, part);
         table.push(&[
-            Cell::U32(k as u32),
-            Cell::U32(k as u32),
-            Cell::U32(part.feature.code()),
-            Cell::OptU32(part.link),
-            Cell::OptU32(part.hinge),
-            Cell::OptU32(part.key),
+            id,
+            name,
+            feature,
+            link,
+            hinge,
+            key,
             Cell::F64(start),
             Cell::F64(end),
             Cell::F64(w.friction_work),

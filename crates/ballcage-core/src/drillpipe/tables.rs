@@ -3,7 +3,7 @@
 //! `keys` and `drive`. Parts are identified by integer columns (`link`,
 //! `hinge`, `key`), never by names.
 
-use super::layout::{Feature, HingeLayout, KeyLayout, Layout};
+use super::layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
 use super::spec::{DrillPipeSpec, PipeTable};
 use super::stress::{PairStress, PairWear, WEAR, pair_stresses, wear_rows};
 use crate::math::{Vec3, angle_between};
@@ -313,39 +313,65 @@ const DRIVE_COLUMNS: &[ColumnDef] = &[
     ),
 ];
 
+/// The columns that say which pair a row is and where it sits in the pipe:
+/// the first six of the `pairs` and `wear` tables ([`pair_cells`]).
+pub(super) const PAIR_ID: ColumnDef = col(
+    "pair_id",
+    U32,
+    "",
+    "contact pair index in the scene's contact list (the contacts and summary tables' pair_id)",
+);
+/// See [`PAIR_ID`].
+pub(super) const PAIR: ColumnDef = col("pair", Name(Dictionary::Pairs), "", "contact pair name");
+/// See [`PAIR_ID`].
+pub(super) const FEATURE: ColumnDef = col(
+    "feature",
+    Name(Dictionary::Labels(Feature::LABELS)),
+    "",
+    "what the pair touches: tube, cage-head, cage-seat, inner-race, outer-race, window or neck-mouth",
+);
+/// See [`PAIR_ID`].
+pub(super) const LINK: ColumnDef = col(
+    "link",
+    OptU32,
+    "",
+    "link number, 1 at the top (tube pairs; null otherwise)",
+);
+/// See [`PAIR_ID`].
+pub(super) const HINGE: ColumnDef = col(
+    "hinge",
+    OptU32,
+    "",
+    "hinge number, 0 above link 1 (joint pairs; null otherwise)",
+);
+/// See [`PAIR_ID`].
+pub(super) const KEY: ColumnDef = col(
+    "key",
+    OptU32,
+    "",
+    "ball key number, 0-5 (key pairs; null otherwise)",
+);
+
+/// The cells of [`PAIR_ID`] … [`KEY`] for pair `k`, `part`.
+pub(super) fn pair_cells(k: usize, part: &PairPart) -> [Cell; 6] {
+    [
+        Cell::U32(k as u32),
+        Cell::U32(k as u32),
+        Cell::U32(part.feature.code()),
+        Cell::OptU32(part.link),
+        Cell::OptU32(part.hinge),
+        Cell::OptU32(part.key),
+    ]
+}
+
 /// Columns of the `pairs` table (drill pipe): one row per contact pair, written once.
 const PAIRS_COLUMNS: &[ColumnDef] = &[
-    col(
-        "pair_id",
-        U32,
-        "",
-        "contact pair index in the scene's contact list (the contacts and summary tables' pair_id)",
-    ),
-    col("pair", Name(Dictionary::Pairs), "", "contact pair name"),
-    col(
-        "feature",
-        Name(Dictionary::Labels(Feature::LABELS)),
-        "",
-        "what the pair touches: tube, cage-head, cage-seat, inner-race, outer-race or window",
-    ),
-    col(
-        "link",
-        OptU32,
-        "",
-        "link number, 1 at the top (tube pairs; null otherwise)",
-    ),
-    col(
-        "hinge",
-        OptU32,
-        "",
-        "hinge number, 0 above link 1 (joint pairs; null otherwise)",
-    ),
-    col(
-        "key",
-        OptU32,
-        "",
-        "ball key number, 0-5 (key pairs; null otherwise)",
-    ),
+    PAIR_ID,
+    PAIR,
+    FEATURE,
+    LINK,
+    HINGE,
+    KEY,
     col(
         "face",
         OptU32,
@@ -517,15 +543,8 @@ fn pairs(table: &mut TableBuffer, layout: &Layout) {
         return;
     }
     for (k, p) in layout.pairs.iter().enumerate() {
-        table.push(&[
-            Cell::U32(k as u32),
-            Cell::U32(k as u32),
-            Cell::U32(p.feature.code()),
-            Cell::OptU32(p.link),
-            Cell::OptU32(p.hinge),
-            Cell::OptU32(p.key),
-            Cell::OptU32(p.face),
-        ]);
+        let [id, name, feature, link, hinge, key] = pair_cells(k, p);
+        table.push(&[id, name, feature, link, hinge, key, Cell::OptU32(p.face)]);
     }
 }
 

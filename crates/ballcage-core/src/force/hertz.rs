@@ -282,7 +282,7 @@ mod tests {
     use approx::assert_relative_eq;
 
     /// Steel on steel, E = 210 GPa, ν = 0.3 both: E* = 210e9/(2·0.91) =
-    /// 115 384.6 MPa (physics.md: 115 385 MPa).
+    /// 115 384.6 MPa (docs/model.md §2.1: 115 385 MPa).
     fn steel() -> f64 {
         effective_modulus(210e9, 0.3, 210e9, 0.3)
     }
@@ -296,7 +296,7 @@ mod tests {
     /// Track radius of the requested ball-in-groove case, 31.5 mm.
     const TRACK: f64 = 31.5e-3;
 
-    /// The key load of physics.md, 33.5 kN.
+    /// The paper's seat–key peak load, 33.5 kN (docs/model.md §2.1).
     const KEY_LOAD: f64 = 33.5e3;
 
     /// A Ø15 ball in a 1.04 groove on a track of signed radius `track`
@@ -358,7 +358,7 @@ mod tests {
         assert_relative_eq!(c.semi_major, 0.365_307e-3, max_relative = 1e-5);
         assert_relative_eq!(c.peak_pressure, 3577.87e6, max_relative = 1e-5);
         assert_relative_eq!(c.approach, 17.7932e-6, max_relative = 1e-5);
-        // physics.md: K_H = (4/3)E*√R = 1.3323e10 N/m^1.5 = 4.213e5 N/mm^1.5,
+        // docs/model.md §2.1: K_H = (4/3)E*√R = 1.3323e10 N/m^1.5 = 4.213e5 N/mm^1.5,
         // so F = K_H δ^1.5 at any load.
         let flat = Elliptical::new([1.0 / BALL, 1.0 / BALL, 0.0, 0.0], e).unwrap();
         for f in [10.0, 1000.0, KEY_LOAD] {
@@ -444,12 +444,12 @@ mod tests {
     }
 
     #[test]
-    fn ball_in_groove_reproduces_the_physics_md_stiffnesses() {
-        // physics.md §Hertz: K_H ≈ 1.14e6 (inner) and 1.20e6 N/mm^1.5
+    fn ball_in_groove_reproduces_the_model_md_stiffnesses() {
+        // docs/model.md §2.1 (Hertz): K_H ≈ 1.14e6 (inner) and 1.20e6 N/mm^1.5
         // (outer), from Hamrock–Brewe, track radius not stated. With the
         // assumed ±31.5 mm (the PCR) the exact solution differs by −1.4 %
         // and +0.3 %. (H-B gives 1.138e6 and 1.200e6 with 26.2 mm and
-        // −39 mm, physics.md's inner contact and outer groove-bottom radii.)
+        // −39 mm, the inner contact and outer groove-bottom radii.)
         // A 2 % tolerance still catches swapped signs: inner and outer
         // differ by 7 %.
         let inner = stiffness_n_per_mm15(&ball_in_groove(TRACK), KEY_LOAD);

@@ -115,6 +115,9 @@ pub struct Recorder {
     engine: Vec<TableKind>,
     observers: Vec<Registered>,
     evals: Vec<Vec<ContactEval>>,
+    /// Whether `evals` holds the current state's points (evaluated by
+    /// [`Self::after_step`] for the step that a frame then records).
+    evals_current: bool,
     stats: Vec<PairStats>,
     needs_pairs: bool,
     /// Whether anything reads every step: the `energy` table or an observer.
@@ -158,11 +161,20 @@ impl Recorder {
             engine,
             observers,
             evals: vec![Vec::new(); model.pairs.len()],
+            evals_current: false,
             stats: vec![PairStats::default(); model.pairs.len()],
             needs_pairs,
             needs_steps,
             dissipated: Dissipated::default(),
             initial_total: None,
+        }
+    }
+
+    /// Every pair's contact points with their forces at `state`, into `evals`.
+    fn evaluate(&mut self, model: &Model, state: &State, dynamics: &mut Dynamics) {
+        for (k, out) in self.evals.iter_mut().enumerate() {
+            out.clear();
+            dynamics.contact_points(model, state, k, out);
         }
     }
 
@@ -173,10 +185,8 @@ impl Recorder {
         if !self.needs_steps {
             return;
         }
-        for (k, out) in self.evals.iter_mut().enumerate() {
-            out.clear();
-            dynamics.contact_points(model, state, k, out);
-        }
+        self.evaluate(model, state, dynamics);
+        self.evals_current = true;
         self.dissipated.add(model, state, &self.evals, h);
         let view = Step {
             model,
@@ -201,12 +211,10 @@ impl Recorder {
         dynamics: &mut Dynamics,
         input_work: (f64, f64),
     ) {
-        if self.needs_pairs {
-            for (k, out) in self.evals.iter_mut().enumerate() {
-                out.clear();
-                dynamics.contact_points(model, state, k, out);
-            }
+        if self.needs_pairs && !self.evals_current {
+            self.evaluate(model, state, dynamics);
         }
+        self.evals_current = false;
         let frame = (Cell::U64(step), Cell::F64(state.t));
         for (table, kind) in self.tables.iter_mut().zip(&self.engine) {
             match kind {
