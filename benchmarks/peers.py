@@ -48,6 +48,8 @@ MAX_CHUNK = 100
 LIMIT_ARM = 0.05
 #: Tube wall of the box ring: half the radial thickness of each box [m].
 BOX_HALF_THICKNESS = 0.005
+#: The bend plane's normal: every ballcage body's z axis, and the z axis of the upper connector's MuJoCo frame.
+BEND_NORMAL = np.array([0.0, -1.0, 0.0])
 
 
 # --------------------------------------------------------------------------- ballcage side
@@ -320,91 +322,108 @@ def _signed_bend(a: np.ndarray, b: np.ndarray, normal: np.ndarray) -> float:
     return math.atan2(float(np.dot(np.cross(a, b), normal)), float(np.dot(a, b)))
 
 
-def mujoco_xml(f: PipeFacts, dt: float, opts: argparse.Namespace) -> tuple[str, dict[str, Any]]:
-    """The MJCF text of the chain and the initial joint values it needs (bent chain on the chords)."""
-    n = f.joints
-    bend_normal = np.array([0.0, -1.0, 0.0])  # every ballcage body's z axis
-    axes = [np.asarray(x, float) for x in f.axes]
-    hinges = [np.asarray(x, float) for x in f.hinges]
-    bends = [_signed_bend(axes[h], axes[h + 1], bend_normal) for h in range(n + 1)]
-    half_c, half_p = f.connector_length / 2.0, f.pitch / 2.0
-    tc = opts.solref_timeconst
-    lim = "" if f.beta_max is None else f'range="{-f.beta_max:.12g} {f.beta_max:.12g}"'
-    upper_pos = hinges[0] - half_c * axes[0]
-    upper_q = _frame(axes[0], bend_normal)
-    lower_centre = hinges[n] + half_c * axes[n + 1]
+def _inertial(mass: float, inertia: list[float]) -> str:
+    """The MJCF inertial element of a body of `mass` [kg] and principal `inertia` [kg m^2]."""
+    return f'<inertial pos="0 0 0" mass="{mass:.12g}" diaginertia="{_fmt(inertia)}"/>'
 
-    def inertial(mass: float, inertia: list[float]) -> str:
-        return f'<inertial pos="0 0 0" mass="{mass:.12g}" diaginertia="{_fmt(inertia)}"/>'
 
-    def cv_joints(h: int, anchor_x: float) -> str:
-        pos = f'pos="{anchor_x:.12g} 0 0"'
-        arm = f'armature="{opts.cv_armature:g}"'
-        if opts.cv == "mirror":  # Ry(a) Rz(c) Ry(a): a pure swing (double-Cardan symmetry), zero twist
-            return (
-                f'<joint name="h{h}_a1" type="hinge" axis="0 1 0" {pos} {arm}/>'
-                f'<joint name="h{h}_c" type="hinge" axis="0 0 1" {pos}/>'
-                f'<joint name="h{h}_a2" type="hinge" axis="0 1 0" {pos} {arm}/>'
-            )
-        if opts.cv == "swing":  # Rx(psi) Ry(beta) Rx(-psi): a pure swing, zero twist
-            return (
-                f'<joint name="h{h}_psi1" type="hinge" axis="1 0 0" {pos} {arm}/>'
-                f'<joint name="h{h}_beta" type="hinge" axis="0 1 0" {pos} {lim}/>'
-                f'<joint name="h{h}_psi2" type="hinge" axis="1 0 0" {pos} {arm}/>'
-            )
-        # universal (Cardan) joint: CV only to first order in the bend
+def _bend_range(f: PipeFacts) -> str:
+    """The range attribute of a bend hinge at the articulation limit ("" without one)."""
+    return "" if f.beta_max is None else f'range="{-f.beta_max:.12g} {f.beta_max:.12g}"'
+
+
+def _cv_joints(f: PipeFacts, h: int, anchor_x: float, opts: argparse.Namespace) -> str:
+    """The hinges of CV joint `h` (``--cv``) at `anchor_x` [m] on the child body's axis."""
+    pos = f'pos="{anchor_x:.12g} 0 0"'
+    arm = f'armature="{opts.cv_armature:g}"'
+    if opts.cv == "mirror":  # Ry(a) Rz(c) Ry(a): a pure swing (double-Cardan symmetry), zero twist
         return (
-            f'<joint name="h{h}_a" type="hinge" axis="0 1 0" {pos}/>'
-            f'<joint name="h{h}_b" type="hinge" axis="0 0 1" {pos}/>'
+            f'<joint name="h{h}_a1" type="hinge" axis="0 1 0" {pos} {arm}/>'
+            f'<joint name="h{h}_c" type="hinge" axis="0 0 1" {pos}/>'
+            f'<joint name="h{h}_a2" type="hinge" axis="0 1 0" {pos} {arm}/>'
         )
-
-    link_geom = (
-        f'type="cylinder" size="{f.link_radius:.12g} {half_p:.12g}"'
-        if opts.link_geom == "cylinder"
-        else f'type="capsule" size="{f.link_radius:.12g} {opts.capsule_half_length or half_p:.12g}"'
+    if opts.cv == "swing":  # Rx(psi) Ry(beta) Rx(-psi): a pure swing, zero twist
+        return (
+            f'<joint name="h{h}_psi1" type="hinge" axis="1 0 0" {pos} {arm}/>'
+            f'<joint name="h{h}_beta" type="hinge" axis="0 1 0" {pos} {_bend_range(f)}/>'
+            f'<joint name="h{h}_psi2" type="hinge" axis="1 0 0" {pos} {arm}/>'
+        )
+    # universal (Cardan) joint: CV only to first order in the bend
+    return (
+        f'<joint name="h{h}_a" type="hinge" axis="0 1 0" {pos}/>'
+        f'<joint name="h{h}_b" type="hinge" axis="0 0 1" {pos}/>'
     )
 
-    # The chain is a kinematic tree: upper connector (driven hinge) -> link 1 -> ... -> lower connector.
-    # The articulation limit (neck on mouth at beta_max): a joint limit on beta for "swing"; otherwise a cone,
-    # as a lower limit on the length 2 L cos(beta / 2) of a tendon between points L from the hinge on both axes.
-    limit_tendon = f.beta_max is not None and opts.cv != "swing"
-    tendons = []
-    if limit_tendon:
-        shortest = 2.0 * LIMIT_ARM * math.cos(f.beta_max / 2.0)
-        for h in range(n + 1):
-            tendons.append(
-                f'<spatial name="h{h}_limit" range="{shortest:.12g} {2.0 * LIMIT_ARM + 1.0:.12g}" '
-                f'solreflimit="{tc:g} 1"><site site="h{h}_p"/><site site="h{h}_c"/></spatial>'
-            )
-    body_open: list[str] = []
-    close = 0
-    # link k sits one pitch (or half a connector plus half a pitch) further along its parent's x axis
-    for k in range(1, n + 2):
-        lower = k == n + 1
-        parent_half = half_c if k == 1 else half_p
-        my_half = half_c if lower else half_p
-        name = "lower" if lower else f"link{k}"
-        s = [f'<body name="{name}" pos="{parent_half + my_half:.12g} 0 0">']
-        if limit_tendon:  # the points one arm from the hinge on either body's axis (the articulation limit)
-            s.append(f'<site name="h{k - 1}_c" pos="{-my_half + LIMIT_ARM:.12g} 0 0"/>')
-            if not lower:
-                s.append(f'<site name="h{k}_p" pos="{my_half - LIMIT_ARM:.12g} 0 0"/>')
-        if lower:
-            s.append(inertial(f.connector_mass, f.connector_inertia))
-            s.append(cv_joints(k - 1, -my_half))
-            s.append(
-                f'<geom class="visual" type="cylinder" size="{f.connector_radius:.12g} {half_c:.12g}" quat="{Z_TO_X}"/>'
-            )
-            s.append(f'<site name="lower_a" pos="{-half_c:.12g} 0 0"/><site name="lower_b" pos="{half_c:.12g} 0 0"/>')
-        else:
-            s.append(inertial(f.link_mass, f.link_inertia))
-            s.append(cv_joints(k - 1, -my_half))
-            # MuJoCo cylinders and capsules lie along their local z: turn z onto the link's x axis
-            s.append(f'<geom name="link{k}" class="link" {link_geom} quat="{Z_TO_X}"/>')
-        body_open.append("".join(s))
-        close += 1
-    chain = "\n".join(body_open) + "</body>" * close
 
+def _link_geom(f: PipeFacts, opts: argparse.Namespace) -> str:
+    """The type and size attributes of a link's geom (``--link-geom``)."""
+    half_p = f.pitch / 2.0
+    if opts.link_geom == "cylinder":
+        return f'type="cylinder" size="{f.link_radius:.12g} {half_p:.12g}"'
+    return f'type="capsule" size="{f.link_radius:.12g} {opts.capsule_half_length or half_p:.12g}"'
+
+
+def _has_limit_tendons(f: PipeFacts, opts: argparse.Namespace) -> bool:
+    """Whether the articulation limit is a tendon (a cone): there is a limit and ``--cv`` is not "swing".
+
+    The limit (neck on mouth at beta_max) is a joint limit on beta for "swing"; otherwise a cone, as a lower
+    limit on the length 2 L cos(beta / 2) of a tendon between points L from the hinge on both axes.
+    """
+    return f.beta_max is not None and opts.cv != "swing"
+
+
+def _limit_tendons(f: PipeFacts, opts: argparse.Namespace) -> list[str]:
+    """The articulation-limit tendon of every hinge, between its two sites LIMIT_ARM from the hinge."""
+    if not _has_limit_tendons(f, opts):
+        return []
+    shortest = 2.0 * LIMIT_ARM * math.cos(f.beta_max / 2.0)
+    return [
+        f'<spatial name="h{h}_limit" range="{shortest:.12g} {2.0 * LIMIT_ARM + 1.0:.12g}" '
+        f'solreflimit="{opts.solref_timeconst:g} 1"><site site="h{h}_p"/><site site="h{h}_c"/></spatial>'
+        for h in range(f.joints + 1)
+    ]
+
+
+def _chain_body(f: PipeFacts, k: int, opts: argparse.Namespace) -> str:
+    """The opening of body `k` of the chain (link k, or the lower connector for k = joints + 1) with its
+    inertia, its CV joint to the parent, its sites and its geom.
+
+    It sits one pitch (or half a connector plus half a pitch) further along its parent's x axis.
+    """
+    lower = k == f.joints + 1
+    half_c, half_p = f.connector_length / 2.0, f.pitch / 2.0
+    parent_half = half_c if k == 1 else half_p
+    my_half = half_c if lower else half_p
+    name = "lower" if lower else f"link{k}"
+    s = [f'<body name="{name}" pos="{parent_half + my_half:.12g} 0 0">']
+    if _has_limit_tendons(f, opts):  # the points one arm from the hinge on either body's axis
+        s.append(f'<site name="h{k - 1}_c" pos="{-my_half + LIMIT_ARM:.12g} 0 0"/>')
+        if not lower:
+            s.append(f'<site name="h{k}_p" pos="{my_half - LIMIT_ARM:.12g} 0 0"/>')
+    if lower:
+        s.append(_inertial(f.connector_mass, f.connector_inertia))
+        s.append(_cv_joints(f, k - 1, -my_half, opts))
+        s.append(
+            f'<geom class="visual" type="cylinder" size="{f.connector_radius:.12g} {half_c:.12g}" quat="{Z_TO_X}"/>'
+        )
+        s.append(f'<site name="lower_a" pos="{-half_c:.12g} 0 0"/><site name="lower_b" pos="{half_c:.12g} 0 0"/>')
+    else:
+        s.append(_inertial(f.link_mass, f.link_inertia))
+        s.append(_cv_joints(f, k - 1, -my_half, opts))
+        # MuJoCo cylinders and capsules lie along their local z: turn z onto the link's x axis
+        s.append(f'<geom name="link{k}" class="link" {_link_geom(f, opts)} quat="{Z_TO_X}"/>')
+    return "".join(s)
+
+
+def _chain(f: PipeFacts, opts: argparse.Namespace) -> str:
+    """The nested bodies below the upper connector: link 1 -> ... -> link n -> lower connector."""
+    bodies = [_chain_body(f, k, opts) for k in range(1, f.joints + 2)]
+    return "\n".join(bodies) + "</body>" * len(bodies)
+
+
+def _equalities(n: int, opts: argparse.Namespace) -> list[str]:
+    """The CV joints' hinge couplings (``--cv`` mirror or swing) and the lower connector's two world points."""
+    tc = opts.solref_timeconst
     equalities = []
     if opts.cv == "mirror":
         for h in range(n + 1):
@@ -414,12 +433,47 @@ def mujoco_xml(f: PipeFacts, dt: float, opts: argparse.Namespace) -> tuple[str, 
             equalities.append(f'<joint joint1="h{h}_psi2" joint2="h{h}_psi1" polycoef="0 -1 0 0 0" solref="{tc:g} 1"/>')
     for end in ("a", "b"):
         equalities.append(f'<connect site1="lower_{end}" site2="world_{end}" solref="{tc:g} 1"/>')
-    world_sites = "".join(
-        f'<site name="world_{end}" pos="{_fmt(lower_centre + sign * half_c * axes[n + 1])}"/>'
+    return equalities
+
+
+def _world_sites(f: PipeFacts) -> str:
+    """The two world points the lower connector's ends are held to, as placed by ballcage."""
+    n, half_c = f.joints, f.connector_length / 2.0
+    axis = np.asarray(f.axes[n + 1], float)
+    centre = np.asarray(f.hinges[n], float) + half_c * axis
+    return "".join(
+        f'<site name="world_{end}" pos="{_fmt(centre + sign * half_c * axis)}"/>'
         for end, sign in (("a", -1.0), ("b", 1.0))
     )
+
+
+def _upper_body(f: PipeFacts, opts: argparse.Namespace) -> str:
+    """The upper connector on its drive hinge, holding the whole chain."""
+    half_c = f.connector_length / 2.0
+    axis = np.asarray(f.axes[0], float)
+    pos = np.asarray(f.hinges[0], float) - half_c * axis
+    q = _frame(axis, BEND_NORMAL)
+    limit_site = f'<site name="h0_p" pos="{half_c - LIMIT_ARM:.12g} 0 0"/>' if _has_limit_tendons(f, opts) else ""
+    return f"""<body name="upper" pos="{_fmt(pos)}" quat="{_fmt(q)}">
+      {_inertial(f.connector_mass, f.connector_inertia)}
+      <joint name="drive" type="hinge" axis="1 0 0"/>
+      {limit_site}
+      <geom class="visual" type="cylinder" size="{f.connector_radius:.12g} {half_c:.12g}" quat="{Z_TO_X}"/>
+      {_chain(f, opts)}
+    </body>"""
+
+
+def mujoco_xml(f: PipeFacts, dt: float, opts: argparse.Namespace) -> tuple[str, dict[str, Any]]:
+    """The MJCF text of the chain and the initial joint values it needs (bent chain on the chords).
+
+    The chain is a kinematic tree: upper connector (driven hinge) -> link 1 -> ... -> lower connector,
+    whose two ends are held to the world by equalities.
+    """
+    n = f.joints
+    axes = [np.asarray(x, float) for x in f.axes]
+    bends = [_signed_bend(axes[h], axes[h + 1], BEND_NORMAL) for h in range(n + 1)]
+    tc = opts.solref_timeconst
     ring_geoms, ring = bore_ring(f, ring_step_deg(f, opts), opts.ring_sectors)
-    kv = opts.drive_kv
     xml = f"""<mujoco model="ballcage-peer-{n}">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{dt!r}" gravity="0 0 {-f.gravity!r}" integrator="{opts.integrator}" cone="{opts.cone}"/>
@@ -432,24 +486,18 @@ def mujoco_xml(f: PipeFacts, dt: float, opts: argparse.Namespace) -> tuple[str, 
     <default class="bore"><geom contype="0" conaffinity="1" group="2" rgba=".6 .6 .7 .3"/></default>
   </default>
   <worldbody>
-    {world_sites}
+    {_world_sites(f)}
     {"".join(ring_geoms)}
-    <body name="upper" pos="{_fmt(upper_pos)}" quat="{_fmt(upper_q)}">
-      {inertial(f.connector_mass, f.connector_inertia)}
-      <joint name="drive" type="hinge" axis="1 0 0"/>
-      {f'<site name="h0_p" pos="{half_c - LIMIT_ARM:.12g} 0 0"/>' if limit_tendon else ""}
-      <geom class="visual" type="cylinder" size="{f.connector_radius:.12g} {half_c:.12g}" quat="{Z_TO_X}"/>
-      {chain}
-    </body>
+    {_upper_body(f, opts)}
   </worldbody>
   <equality>
-    {"".join(equalities)}
+    {"".join(_equalities(n, opts))}
   </equality>
   <tendon>
-    {"".join(tendons)}
+    {"".join(_limit_tendons(f, opts))}
   </tendon>
   <actuator>
-    <velocity name="drive" joint="drive" kv="{kv:g}"/>
+    <velocity name="drive" joint="drive" kv="{opts.drive_kv:g}"/>
   </actuator>
 </mujoco>
 """
@@ -499,108 +547,152 @@ def build_mujoco(f: PipeFacts, dt: float, opts: argparse.Namespace):
     return m, d, info
 
 
+class MujocoRun:
+    """One MuJoCo run of the chain: the drive and the resisting moment applied, each link's tube contact
+    normal forces summed over the recorded frames of the window, and what the recording cost."""
+
+    def __init__(
+        self, f: PipeFacts, dt: float, duration: float, window: tuple[float, float], opts: argparse.Namespace
+    ) -> None:
+        self.f, self.dt = f, dt
+        self.m, self.d, self.info = build_mujoco(f, dt, opts)
+        n = f.joints
+        self.link_of_geom = np.zeros(self.m.ngeom, dtype=np.int64)
+        for k in range(1, n + 1):
+            self.link_of_geom[self.m.geom(f"link{k}").id] = k
+        self.lower = self.m.body("lower").id
+        self.lower_axis = np.asarray(f.axes[n + 1], float)
+        self.stride = max(1, round(f.output_interval / dt))
+        self.nsteps = round(duration / dt)
+        # the last ramp step sets the final values
+        self.ramp_steps = math.ceil(max(f.drive_ramp, f.load_ramp) / dt - 1e-9) + 1
+        self.first = math.ceil(window[0] / f.output_interval - 1e-9) * self.stride  # first recorded step index
+        self.last = math.floor(window[1] / f.output_interval + 1e-9) * self.stride  # last recorded step index
+        self.sums = np.zeros(n + 1)
+        self.frames = 0
+        self.ncon_sum = 0
+        self.force = np.zeros(6)
+        self.t_extract = self.c_extract = 0.0  # wall and CPU time of the recording [s]
+        self.bad = int(mujoco.mjtWarning.mjWARN_BADQACC)
+        self.k = 0  # steps taken
+
+    def controls(self, t: float) -> None:
+        """The drive speed and the resisting moment at time `t` [s]."""
+        f, d = self.f, self.d
+        d.ctrl[0] = _step(t, 0.0, 0.0, f.drive_ramp, f.omega) if f.drive_ramp > 0 else f.omega
+        s = _step(t, 0.0, 0.0, f.load_ramp, 1.0) if f.load_ramp > 0 else 1.0
+        d.xfrc_applied[self.lower, 3:6] = -f.moment * s * self.lower_axis
+
+    def extract(self) -> None:
+        """Records a frame: adds each link's contact normal forces to its sum."""
+        m, d = self.m, self.d
+        self.frames += 1
+        self.ncon_sum += d.ncon
+        for i in range(d.ncon):
+            c = d.contact[i]
+            k = self.link_of_geom[c.geom1] or self.link_of_geom[c.geom2]
+            if k and c.efc_address >= 0:
+                mujoco.mj_contactForce(m, d, i, self.force)
+                self.sums[k] += self.force[0]
+
+    def recorded(self, k: int) -> bool:
+        """Whether the state after step `k` is a frame of the window."""
+        return self.first <= k <= self.last and k % self.stride == 0
+
+    def next_frame(self, k: int) -> int:
+        """The step index of the next recorded frame after step `k` (the run's end once past the window)."""
+        if k < self.first:
+            return self.first
+        return (k // self.stride + 1) * self.stride if k < self.last else self.nsteps
+
+    def advance(self) -> None:
+        """Steps to the end of the run, or until MuJoCo reports a bad acceleration (and resets the state)."""
+        m, d, dt = self.m, self.d, self.dt
+        while self.k < self.nsteps:
+            k = self.k
+            if d.warning[self.bad].number:  # MuJoCo has reset the state: stop here
+                return
+            if k < self.ramp_steps or self.recorded(k):
+                self.controls(k * dt)
+                mujoco.mj_step(m, d)  # its contact forces are those of the state at k*dt
+                if self.recorded(k):
+                    te, ce = time.perf_counter(), time.process_time()
+                    self.extract()
+                    self.t_extract += time.perf_counter() - te
+                    self.c_extract += time.process_time() - ce
+                self.k += 1
+            else:  # constant controls, nothing to record: MuJoCo runs the steps up to the next frame in C
+                nxt = self.next_frame(k)
+                chunk = max(1, min(nxt, self.nsteps, k + MAX_CHUNK) - k)
+                mujoco.mj_step(m, d, nstep=chunk)
+                self.k += chunk
+
+    def timed_run(self) -> tuple[float, float, str]:
+        """Runs to the end: wall and CPU time [s] of the stepping (recording excluded), and why MuJoCo
+        stopped ("" if it did not)."""
+        fatal = ""
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            self.advance()
+        except mujoco.FatalError as e:  # e.g. the arena overflows once a diverging run has thousands of contacts
+            fatal = f"MuJoCo stopped by t = {self.k * self.dt:.4g} s: {str(e).splitlines()[0][:120]}"
+        wall = time.perf_counter() - t0 - self.t_extract
+        cpu = time.process_time() - c0 - self.c_extract
+        return wall, cpu, fatal
+
+    def finish(self, fatal: str) -> tuple[str, bool]:
+        """The run's note and whether it completed; a complete run records its final frame if it is one."""
+        d = self.d
+        note, complete = fatal, not fatal
+        if complete and (not np.isfinite(d.qpos).all() or d.warning[self.bad].number):
+            note, complete = f"unstable by t = {self.k * self.dt:.4g} s (bad qacc; MuJoCo reset the state)", False
+        if complete and self.recorded(self.nsteps):  # the frame at the end of the run
+            mujoco.mj_forward(self.m, d)
+            self.extract()
+        return note, complete
+
+    def means(self) -> list[float]:
+        """Each link's mean tube normal force over the recorded frames [N], links 1..joints."""
+        return [float(self.sums[k] / self.frames) if self.frames else 0.0 for k in range(1, self.f.joints + 1)]
+
+    def extra(self, cpu: float, opts: argparse.Namespace) -> dict[str, Any]:
+        """The run's costs (`cpu` [s], recording, MuJoCo's timers per step), contacts and model size."""
+        timer = {
+            name: self.d.timer[int(getattr(mujoco.mjtTimer, f"mjTIMER_{name.upper()}"))]
+            for name in ("step", "pos_collision", "constraint")
+        }
+        per_step_ms = {
+            f"{name}_ms_per_step": (tm.duration / tm.number * 1e3 if tm.number else math.nan)
+            for name, tm in timer.items()
+        }
+        info = self.info
+        return {
+            "cpu_s": cpu,
+            "extract_s": self.t_extract,
+            **per_step_ms,
+            "mean_ncon_in_window": self.ncon_sum / self.frames if self.frames else math.nan,
+            "nbody": info.nbody,
+            "nv": info.nv,
+            "ngeom": info.ngeom,
+            "neq": info.neq,
+            "ring_boxes": info.ring.boxes,
+            "integrator": opts.integrator,
+            "cone": opts.cone,
+            "cv": opts.cv,
+            "link_geom": opts.link_geom,
+            "mujoco": mujoco.__version__,
+        }
+
+
 def run_mujoco(
     f: PipeFacts, dt: float, duration: float, window: tuple[float, float], opts: argparse.Namespace
 ) -> Result:
-    m, d, info = build_mujoco(f, dt, opts)
-    n = f.joints
-    link_of_geom = np.zeros(m.ngeom, dtype=np.int64)
-    for k in range(1, n + 1):
-        link_of_geom[m.geom(f"link{k}").id] = k
-    lower = m.body("lower").id
-    lower_axis = np.asarray(f.axes[n + 1], float)
-    stride = max(1, round(f.output_interval / dt))
-    nsteps = round(duration / dt)
-    ramp_steps = math.ceil(max(f.drive_ramp, f.load_ramp) / dt - 1e-9) + 1  # the last one sets the final values
-    first = math.ceil(window[0] / f.output_interval - 1e-9) * stride  # first recorded step index
-    last = math.floor(window[1] / f.output_interval + 1e-9) * stride  # last recorded step index
-    sums = np.zeros(n + 1)
-    frames = 0
-    force = np.zeros(6)
-    t_extract = c_extract = 0.0
-
-    def controls(t: float) -> None:
-        d.ctrl[0] = _step(t, 0.0, 0.0, f.drive_ramp, f.omega) if f.drive_ramp > 0 else f.omega
-        s = _step(t, 0.0, 0.0, f.load_ramp, 1.0) if f.load_ramp > 0 else 1.0
-        d.xfrc_applied[lower, 3:6] = -f.moment * s * lower_axis
-
-    ncon_sum = 0
-
-    def extract() -> None:
-        nonlocal frames, ncon_sum
-        frames += 1
-        ncon_sum += d.ncon
-        for i in range(d.ncon):
-            c = d.contact[i]
-            k = link_of_geom[c.geom1] or link_of_geom[c.geom2]
-            if k and c.efc_address >= 0:
-                mujoco.mj_contactForce(m, d, i, force)
-                sums[k] += force[0]
-
-    def recorded(k: int) -> bool:
-        return first <= k <= last and k % stride == 0
-
-    bad = int(mujoco.mjtWarning.mjWARN_BADQACC)
-    k = 0
-
-    def advance() -> None:
-        nonlocal k, t_extract, c_extract
-        while k < nsteps:
-            if d.warning[bad].number:  # MuJoCo has reset the state: stop here
-                return
-            if k < ramp_steps or recorded(k):
-                controls(k * dt)
-                mujoco.mj_step(m, d)  # its contact forces are those of the state at k*dt
-                if recorded(k):
-                    te, ce = time.perf_counter(), time.process_time()
-                    extract()
-                    t_extract += time.perf_counter() - te
-                    c_extract += time.process_time() - ce
-                k += 1
-            else:  # constant controls, nothing to record: MuJoCo runs the steps up to the next frame in C
-                nxt = first if k < first else (k // stride + 1) * stride if k < last else nsteps
-                chunk = max(1, min(nxt, nsteps, k + MAX_CHUNK) - k)
-                mujoco.mj_step(m, d, nstep=chunk)
-                k += chunk
-
-    fatal = ""
-    t0, c0 = time.perf_counter(), time.process_time()
-    try:
-        advance()
-    except mujoco.FatalError as e:  # e.g. the arena overflows once a diverging run has thousands of contacts
-        fatal = f"MuJoCo stopped by t = {k * dt:.4g} s: {str(e).splitlines()[0][:120]}"
-    wall = time.perf_counter() - t0 - t_extract
-    cpu = time.process_time() - c0 - c_extract
-    note, complete = fatal, not fatal
-    if complete and (not np.isfinite(d.qpos).all() or d.warning[bad].number):
-        note, complete = f"unstable by t = {k * dt:.4g} s (bad qacc; MuJoCo reset the state)", False
-    if complete and recorded(nsteps):  # the frame at the end of the run
-        mujoco.mj_forward(m, d)
-        extract()
-    means = [float(sums[k] / frames) if frames else 0.0 for k in range(1, n + 1)]
-    timer = {
-        name: d.timer[int(getattr(mujoco.mjtTimer, f"mjTIMER_{name.upper()}"))]
-        for name in ("step", "pos_collision", "constraint")
-    }
-    per_step_ms = {
-        f"{name}_ms_per_step": (tm.duration / tm.number * 1e3 if tm.number else math.nan) for name, tm in timer.items()
-    }
-    extra = {
-        "cpu_s": cpu,
-        "extract_s": t_extract,
-        **per_step_ms,
-        "mean_ncon_in_window": ncon_sum / frames if frames else math.nan,
-        "nbody": info.nbody,
-        "nv": info.nv,
-        "ngeom": info.ngeom,
-        "neq": info.neq,
-        "ring_boxes": info.ring.boxes,
-        "integrator": opts.integrator,
-        "cone": opts.cone,
-        "cv": opts.cv,
-        "link_geom": opts.link_geom,
-        "mujoco": mujoco.__version__,
-    }
+    """MuJoCo's run of the chain of `f` at step `dt` for `duration` [s], forces averaged over `window`."""
+    run = MujocoRun(f, dt, duration, window, opts)
+    wall, cpu, fatal = run.timed_run()
+    note, complete = run.finish(fatal)
+    extra = run.extra(cpu, opts)
+    n, k, frames, means = f.joints, run.k, run.frames, run.means()
     return Result("mujoco", dt, n, duration, wall, k, frames, means, complete, note, extra, reached=k * dt)
 
 
@@ -777,10 +869,8 @@ def reference(joints: int, dt: float, duration: float, window: tuple[float, floa
     return r
 
 
-def main(argv: list[str] | None = None) -> int:
-    p = argparse.ArgumentParser(
-        description=__doc__.split("\n\n")[0], formatter_class=argparse.ArgumentDefaultsHelpFormatter
-    )
+def add_run_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of the comparison: steps, chains, window, engines, reference, outputs and the scene."""
     p.add_argument("--dt", type=float, nargs="+", default=[1e-3, 1e-4], help="steps [s] for both engines")
     p.add_argument("--duration", type=float, default=1.8, help="simulated time [s]")
     p.add_argument("--joints", type=int, nargs="+", default=[12], help="numbers of joints (links)")
@@ -826,6 +916,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--describe", action="store_true", help="print the MuJoCo model's parameters and exit")
     p.add_argument("--xml", type=Path, default=None, help="also write the MuJoCo model (first joints, first dt) here")
+
+
+def add_model_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of the MuJoCo model, in their own group."""
     g = p.add_argument_group("MuJoCo model")
     g.add_argument(
         "--cv",
@@ -866,6 +960,88 @@ def main(argv: list[str] | None = None) -> int:
         "singular at zero bend",
     )
     g.add_argument("--memory", default="64M", help="MuJoCo arena size")
+
+
+def parser() -> argparse.ArgumentParser:
+    """The command line of this script."""
+    p = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.ArgumentDefaultsHelpFormatter
+    )
+    add_run_arguments(p)
+    add_model_arguments(p)
+    return p
+
+
+def show_model(facts: PipeFacts, joints: int, opts: argparse.Namespace) -> None:
+    """Prints how the MuJoCo model of `facts` is built, and writes its MJCF with ``--xml`` (first joints, first dt)."""
+    _, ring = bore_ring(facts, ring_step_deg(facts, opts), opts.ring_sectors)
+    print(describe(facts, ring, opts))
+    if opts.xml and joints == opts.joints[0]:
+        opts.xml.write_text(mujoco_xml(facts, opts.dt[0], opts)[0])
+
+
+def run_references(joints: int, window: tuple[float, float], opts: argparse.Namespace) -> list[Result]:
+    """ballcage's reference run for `joints`, and with ``--reference-check`` the one at twice its step."""
+    ref = reference(joints, opts.reference_dt, opts.duration, window, opts.reference_cache)
+    out = [ref]
+    print(f"  reference ballcage dt {opts.reference_dt:g}: {ref.wall_s:.2f} s", flush=True)
+    if opts.reference_check:
+        check = reference(joints, 2.0 * opts.reference_dt, opts.duration, window, opts.reference_cache)
+        check.engine = "ballcage-ref-check"
+        out.append(check)
+        print(f"  reference check ballcage dt {2.0 * opts.reference_dt:g}: {check.wall_s:.2f} s", flush=True)
+    return out
+
+
+def run_engines(
+    facts: PipeFacts, joints: int, window: tuple[float, float], opts: argparse.Namespace
+) -> list[Result]:
+    """Each engine's run at each step of ``--dt``, forces averaged over `window` [s]."""
+    results = []
+    for dt in opts.dt:
+        for engine in opts.engines:
+            if engine == "ballcage":
+                r = run_ballcage(joints, dt, opts.duration, window)
+            else:
+                r = run_mujoco(facts, dt, opts.duration, window, opts)
+            r.extra["window"] = list(window)
+            results.append(r)
+            print(
+                f"  {engine} dt {dt:g}, {joints} joints: {r.wall_s:.3f} s"
+                + ("" if r.complete else f" INCOMPLETE: {r.note}"),
+                flush=True,
+            )
+    return results
+
+
+def write_results(
+    path: Path, rows: list[dict[str, Any]], refs: dict[int, Result], opts: argparse.Namespace
+) -> None:
+    """The result rows as CSV (by the suffix), or as JSON with the options, versions and reference runs."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix == ".csv":
+        flat = [{k: (json.dumps(v) if isinstance(v, (list, dict)) else v) for k, v in r.items()} for r in rows]
+        keys = sorted({k for r in flat for k in r})
+        with path.open("w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=keys)
+            w.writeheader()
+            w.writerows(flat)
+    else:
+        meta = {
+            "argv": sys.argv,
+            "options": {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(opts).items()},
+            "ballcage": ballcage.__version__,
+            "mujoco": getattr(mujoco, "__version__", None),
+            "python": platform.python_version(),
+            "results": rows,
+            "references": {j: asdict(r) for j, r in refs.items()},
+        }
+        path.write_text(json.dumps(meta, indent=1))
+    print(f"results: {path}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = parser()
     opts = p.parse_args(argv)
     SCENE_SETTINGS.update(overrides=list(opts.overrides), fit_arc=opts.fit_arc)
 
@@ -883,62 +1059,21 @@ def main(argv: list[str] | None = None) -> int:
         facts = pipe_facts(ballcage_scene(joints, opts.dt[0], opts.duration))
         window = tuple(opts.window) if opts.window else default_window(opts.duration, facts)
         if mujoco is not None:
-            _, ring = bore_ring(facts, ring_step_deg(facts, opts), opts.ring_sectors)
-            print(describe(facts, ring, opts))
-            if opts.xml and joints == opts.joints[0]:
-                opts.xml.write_text(mujoco_xml(facts, opts.dt[0], opts)[0])
+            show_model(facts, joints, opts)
             if opts.describe:
                 return 0
         print(f"window {window[0]:.4g}-{window[1]:.4g} s")
         if not opts.no_reference:
-            ref = reference(joints, opts.reference_dt, opts.duration, window, opts.reference_cache)
-            refs[joints] = ref
-            results.append(ref)
-            print(f"  reference ballcage dt {opts.reference_dt:g}: {ref.wall_s:.2f} s", flush=True)
-            if opts.reference_check:
-                check = reference(joints, 2.0 * opts.reference_dt, opts.duration, window, opts.reference_cache)
-                check.engine = "ballcage-ref-check"
-                results.append(check)
-                print(f"  reference check ballcage dt {2.0 * opts.reference_dt:g}: {check.wall_s:.2f} s", flush=True)
-        for dt in opts.dt:
-            for engine in opts.engines:
-                if engine == "ballcage":
-                    r = run_ballcage(joints, dt, opts.duration, window)
-                else:
-                    r = run_mujoco(facts, dt, opts.duration, window, opts)
-                r.extra["window"] = list(window)
-                results.append(r)
-                print(
-                    f"  {engine} dt {dt:g}, {joints} joints: {r.wall_s:.3f} s"
-                    + ("" if r.complete else f" INCOMPLETE: {r.note}"),
-                    flush=True,
-                )
+            references = run_references(joints, window, opts)
+            refs[joints] = references[0]
+            results += references
+        results += run_engines(facts, joints, window, opts)
     rows = print_tables(results, refs)
     if opts.out:
-        opts.out.parent.mkdir(parents=True, exist_ok=True)
-        if opts.out.suffix == ".csv":
-            flat = [{k: (json.dumps(v) if isinstance(v, (list, dict)) else v) for k, v in r.items()} for r in rows]
-            keys = sorted({k for r in flat for k in r})
-            with opts.out.open("w", newline="") as fh:
-                w = csv.DictWriter(fh, fieldnames=keys)
-                w.writeheader()
-                w.writerows(flat)
-        else:
-            meta = {
-                "argv": sys.argv,
-                "options": {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(opts).items()},
-                "ballcage": ballcage.__version__,
-                "mujoco": getattr(mujoco, "__version__", None),
-                "python": platform.python_version(),
-                "results": rows,
-                "references": {j: asdict(r) for j, r in refs.items()},
-            }
-            opts.out.write_text(json.dumps(meta, indent=1))
-        print(f"results: {opts.out}")
+        write_results(opts.out, rows, refs, opts)
     if opts.plot:
         plot(rows, opts.plot)
     return 0
-
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -5,7 +5,7 @@ Runs a fixed set of scenes with every table recorded, using whichever
 `ballcage` the Python running this script imports, and writes the tables as
 Parquet; then compares two such folders column by column, bit for bit.
 
-    python3 scripts/compare_tables.py run DIR [--duration S]
+    python3 scripts/compare_tables.py run DIR [--duration S] [--set KEY=VALUE ...]
     python3 scripts/compare_tables.py compare BEFORE AFTER
 
 To compare two commits, install each into its own virtual environment
@@ -29,7 +29,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-ALL_TABLES = ["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive"]
+ALL_TABLES = ["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive", "pairs", "wear"]
 ENGINE_TABLES = ["bodies", "contacts", "energy", "summary"]
 
 #: name -> (scene source: "paper" or a TOML file, overrides)
@@ -57,10 +57,11 @@ def _run_case(source: str, overrides: list[str], duration: float, root: Path) ->
     return sim.finish()
 
 
-def run(out: Path, duration: float) -> int:
+def run(out: Path, duration: float, paper_overrides: list[str]) -> int:
     root = Path(__file__).resolve().parent.parent
     for name, (source, overrides) in CASES.items():
-        tables = _run_case(source, overrides, duration, root)
+        extra = paper_overrides if source == "paper" else []
+        tables = _run_case(source, [*overrides, *extra], duration, root)
         folder = out / name
         folder.mkdir(parents=True, exist_ok=True)
         for table_name, table in tables.items():
@@ -114,12 +115,19 @@ def main(argv: list[str] | None = None) -> int:
     r = sub.add_parser("run", help="run the cases and write DIR/<case>/<table>.parquet")
     r.add_argument("out", type=Path)
     r.add_argument("--duration", type=float, default=0.4, help="simulated time of the paper cases [s] (default 0.4)")
+    r.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="an override for the paper cases (repeatable), e.g. to keep a law a later change made optional",
+    )
     c = sub.add_parser("compare", help="compare two folders written by `run`")
     c.add_argument("before", type=Path)
     c.add_argument("after", type=Path)
     args = parser.parse_args(argv)
     if args.command == "run":
-        return run(args.out, args.duration)
+        return run(args.out, args.duration, args.set)
     return compare(args.before, args.after)
 
 

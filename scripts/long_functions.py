@@ -1,7 +1,16 @@
 #!/usr/bin/env python3
-"""Lists functions longer than a limit in the Rust core (with ballcage-shapes) and the Python package.
+"""Lists functions longer than a limit anywhere in the tree's Rust and Python source.
 
 Usage: python3 scripts/long_functions.py [LIMIT]   (default 80 lines)
+
+Scans every `.rs` and `.py` file under SCANNED (below): the Rust crates
+under `crates/` (ballcage-core, ballcage-shapes, ballcage-py and the bench
+crate ballcage-bench) with their `src/`, `tests/`, `benches/` and
+`examples/`; the fuzz crate `fuzz/` (src, fuzz_targets, tests, examples); the
+Python package `python/ballcage`; the pytest suite `tests/`; the peer
+benchmarks `benchmarks/`; and these scripts, `scripts/`. Folders named in
+SKIPPED (build output such as `target/`, libFuzzer's `artifacts/` and
+`corpus/`, caches) are not source and are not scanned.
 
 Rust: a `fn` item runs from its signature line to the line of its closing brace
 (brace matching, ignoring braces in strings, chars and comments well enough for
@@ -17,6 +26,9 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+# Folders scanned, from the repository root, and folder names skipped within them.
+SCANNED = ("crates", "fuzz", "python/ballcage", "tests", "benchmarks", "scripts")
+SKIPPED = {"target", "artifacts", "corpus", "coverage", "__pycache__", ".pytest_cache"}
 FN = re.compile(r"^\s*(pub(\([^)]*\))?\s+)?(const\s+)?(async\s+)?(unsafe\s+)?fn\s+(\w+)")
 
 
@@ -59,13 +71,22 @@ def python_functions(path: Path):
             yield node.name, node.lineno, node.end_lineno - node.lineno + 1
 
 
+def sources(suffix: str) -> list[Path]:
+    """Every file ending in `suffix` under SCANNED, outside SKIPPED folders."""
+    found = []
+    for folder in SCANNED:
+        for path in (ROOT / folder).rglob(f"*{suffix}"):
+            if not SKIPPED.intersection(path.relative_to(ROOT).parts):
+                found.append(path)
+    return sorted(found)
+
+
 def main() -> int:
     limit = int(sys.argv[1]) if len(sys.argv) > 1 else 80
     found = []
-    for crate in ("crates/ballcage-core/src", "crates/ballcage-shapes/src"):
-        for path in sorted((ROOT / crate).rglob("*.rs")):
-            found += [(n, path, line, length) for n, line, length in rust_functions(path)]
-    for path in sorted((ROOT / "python/ballcage").rglob("*.py")):
+    for path in sources(".rs"):
+        found += [(n, path, line, length) for n, line, length in rust_functions(path)]
+    for path in sources(".py"):
         found += [(n, path, line, length) for n, line, length in python_functions(path)]
     over = sorted((f for f in found if f[3] > limit), key=lambda f: -f[3])
     for name, path, line, length in over:

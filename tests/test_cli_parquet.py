@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
+from signalled import python_command
 
 import ballcage
 
@@ -229,7 +230,7 @@ def test_a_real_sigint_leaves_readable_tables_marked_incomplete(tmp_path):
 
     out = tmp_path / "out"
     proc = subprocess.Popen(
-        [sys.executable, "-m", "ballcage", "run", "--out", str(out), "--set", "pipe.joints=4"],
+        python_command("-m", "ballcage", "run", "--out", str(out), "--set", "pipe.joints=4"),
         stderr=subprocess.PIPE,
         stdout=subprocess.DEVNULL,
         text=True,

@@ -34,6 +34,7 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
+from signalled import python_command
 
 import ballcage
 from ballcage.scene import default_scene
@@ -206,8 +207,8 @@ def _interrupted_then_resumed(tmp_path: Path) -> tuple[Path, int]:
     spec.write_text(SWEEP_TOML, encoding="utf-8")
     for attempt in range(3):
         shutil.rmtree(out, ignore_errors=True)
-        proc = subprocess.Popen([sys.executable, "-m", "ballcage", "sweep", str(spec), "--out", str(out), "--workers",
-                                 "1", "--no-plots"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        command = python_command("-m", "ballcage", "sweep", str(spec), "--out", str(out), "--workers", "1", "--no-plots")
+        proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         deadline = time.monotonic() + TIMEOUT_S
         while proc.poll() is None and not list(out.glob("cases/*.json")):
             assert time.monotonic() < deadline, "the sweep wrote no record"

@@ -113,6 +113,16 @@ def test_the_wear_table_integrates_the_frames_friction(run):
     assert losses["tube"] > 100.0 and losses["key–race"] > 10.0
 
 
+def test_the_drive_tables_friction_split_matches_the_wear_table(run):
+    # losses_curvature.png splits each sweep case's loss from its drive table: the cases record no wear table.
+    from ballcage.paper.section4_figures import friction_split
+
+    split, losses = friction_split(run), loss_breakdown(run.tables["wear"])
+    assert split is not None and list(split) == list(losses)
+    for group in ("tube", "key–race", "cage"):
+        assert split[group] == pytest.approx(losses[group], rel=0.05), group
+
+
 def test_window_pressure_is_hertz_ball_on_a_flat(run):
     # Ball (r = 7.5 mm) on a flat: p0 = (6 F E*² / (π³ R²))^(1/3), E* of bearing steel on 35CrMo.
     s = run.scene

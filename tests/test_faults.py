@@ -33,6 +33,7 @@ import pyarrow.compute as pc
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 import pytest
+from signalled import python_command
 
 import ballcage
 
@@ -58,9 +59,13 @@ BIG_RUN = ("--set", "pipe.joints=2", "--set", "simulation.duration=0.04", "--set
 
 
 def _start(args: list[str] | tuple[str, ...], log: Path, prefix: tuple[str, ...] = ()) -> subprocess.Popen[bytes]:
-    """Starts ``python [prefix] -m ballcage ARGS`` with stderr into the file `log`."""
+    """Starts ``python [prefix] -m ballcage ARGS`` with stderr into the file `log`.
+
+    SIGINT and SIGTERM at their default disposition in the child (`signalled.python_command`),
+    even when pytest was started with them ignored (``nohup``, cron, a background job).
+    """
     with open(log, "wb") as err:
-        command = [sys.executable, *(prefix or ("-m", "ballcage")), *args]
+        command = python_command(*(prefix or ("-m", "ballcage")), *args)
         return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=err)
 
 

@@ -223,9 +223,9 @@ def test_comparison_md_lists_the_phases_once(short_paper_run):
 
 def test_fig09_tells_the_hinges_apart_and_marks_the_articulation_limit(short_paper_run):
     from ballcage._plot import series_styles
+    from ballcage.measures.frames import frame_times
+    from ballcage.measures.phases import scene_facts
     from ballcage.paper import figures
-    from ballcage.paper.facts import scene_facts
-    from ballcage.paper.frames import frame_times
 
     styles = series_styles(12)
     assert len({(s["color"], s["ls"], s["marker"]) for s in styles}) == 12

@@ -22,8 +22,8 @@ import pytest
 
 import ballcage
 from ballcage import paper, studies
-from ballcage.paper import frames as paper_frames
-from ballcage.paper import motion as paper_motion
+from ballcage.measures import frames as paper_frames
+from ballcage.measures import motion as paper_motion
 
 REPO = Path(__file__).resolve().parent.parent
 #: The reference file of the project's shared folder (beside the repository in CI, or /work/shared).
@@ -64,7 +64,10 @@ def _reference_quantities(path: Path | None = None) -> list[dict]:
 
 #: Rows the comparison adds to the reference file's: (key, the key it follows, unit, paper value).
 EXTRA_ROWS = [
+    ("included_angle_projected_min_deg", "included_angle_min_deg", "deg", 172.8),
+    ("included_angle_projected_max_deg", "included_angle_max_deg", "deg", 176.0),
     ("range_of_motion_peak_to_peak_mm", "range_of_motion_mm", "mm", 25.3),
+    ("tube_normal_mean_max_inclination_deg", "tube_normal_mean_joint12_n", "deg", None),
     ("head_cage_normal_peak_n", "seat_cage_normal_peak_n", "N", None),
 ]
 
@@ -322,31 +325,6 @@ def _brute_peak_to_peak(x: np.ndarray, y: np.ndarray) -> float:
     return float(d.max())
 
 
-@pytest.mark.parametrize(
-    ("links", "deformation", "link", "tied"),
-    [
-        ([4, 6, 5, 4], [0.023, 0.024, 0.025, 0.025], 4, (4,)),  # the paper's phases: 4, never round(4.75) = 5
-        ([2, 2, 9, 9], [0.010, 0.011, 0.012, 0.009], 9, (2, 9)),  # tie: 9 reaches the largest offset
-        ([11, 2, 2, 3], [0.015, 0.014, 0.0149, 0.015], 2, (2,)),  # mean 4.5 would name a link no phase has
-        ([7], [0.001], 7, (7,)),
-        ([3, 8], [0.012, 0.012], 3, (3, 8)),  # equal offsets too: the lower link number
-    ],
-)
-def test_most_frequent_link_of_the_phases(links, deformation, link, tied):
-    chosen = paper_motion.most_frequent(links, deformation)
-    assert chosen.link == link
-    assert chosen.tied == tied
-    assert chosen.tie == (len(tied) > 1)
-    assert chosen.count == links.count(link)
-
-
-def test_most_frequent_refuses_mismatched_or_empty_phases():
-    with pytest.raises(ValueError):
-        paper_motion.most_frequent([], [])
-    with pytest.raises(ValueError):
-        paper_motion.most_frequent([1, 2], [0.1])
-
-
 def test_peak_to_peak_of_a_circle_is_its_diameter_and_the_offset_its_radius():
     # A centre going once round a circle of radius 10 mm: 20 mm peak to peak, 10 mm largest offset.
     theta = np.linspace(0.0, 2.0 * math.pi, 601)
@@ -372,14 +350,19 @@ def test_peak_to_peak_matches_every_pair_on_random_paths():
 def _synthetic_run(duration: float = 0.6, interval: float = 0.05) -> ballcage.Run:
     """A links table built by hand on the paper scene's TOML (100 rpm: phases at 0.15, 0.3, 0.45, 0.6 s).
 
-    Link 4 circles the centreline at 10 mm once over the run; link 6 sits 12 mm out at the 90° phase and link 5
-    11 mm out at the 180° phase; every other centre stays 1 mm out. The most deformed links of the phases are
-    therefore 4, 6, 5, 4. Link k's included angle is 180 - k - frame / 100 deg.
+    Every hinge bends 5 deg + frame / 100 deg, hinge 4 3 deg more (the most deformed joint: mean bend over the last
+    revolution, here the whole run, 3 deg above every other). The chain lies in the bend plane (azimuth 0, each
+    inclination the sum of the bends above), so projected and 3-D included angles agree. Link 4 circles the
+    centreline at 10 mm once over the run; link 6 sits 12 mm out at the 90° phase and link 5 11 mm out at the 180°
+    phase; every other centre stays 1 mm out: the links furthest out at the phases are 4, 6, 5, 4, which no longer
+    decide the most deformed joint.
     """
     scene = paper.paper_scene([f"simulation.duration={duration}", f"simulation.output_interval={interval}"])
     times = np.round(np.arange(0.0, duration + interval / 2, interval), 12)
-    cols: dict[str, list] = {c: [] for c in ("t", "link", "offset_outward", "offset_lateral", "included_angle_deg")}
+    names = ("t", "link", "offset_outward", "offset_lateral", "included_angle_deg", "inclination_deg", "azimuth_deg")
+    cols: dict[str, list] = {c: [] for c in names}
     for f, t in enumerate(times):
+        inclination = 1.0
         for k in range(1, 13):
             out, lat = 0.001, 0.0
             if k == 4:
@@ -389,9 +372,10 @@ def _synthetic_run(duration: float = 0.6, interval: float = 0.05) -> ballcage.Ru
                 out = 0.012
             elif k == 5 and f == 9:
                 out = 0.011
-            for name, v in (("t", t), ("link", k), ("offset_outward", out), ("offset_lateral", lat)):
+            bend = _synthetic_bend(k, f)
+            for name, v in zip(names, (t, k, out, lat, 180.0 - bend, inclination, 0.0), strict=True):
                 cols[name].append(v)
-            cols["included_angle_deg"].append(180.0 - k - f / 100.0)
+            inclination += bend
     table = pa.table(cols)
     table = table.append_column("radial_offset", pa.array(np.hypot(cols["offset_outward"], cols["offset_lateral"])))
     zeros = pa.array(np.zeros(table.num_rows))
@@ -399,23 +383,33 @@ def _synthetic_run(duration: float = 0.6, interval: float = 0.05) -> ballcage.Ru
     return ballcage.Run({"links": table}, scene.to_toml())
 
 
+def _synthetic_bend(hinge: int, frame: int) -> float:
+    """Hinge `hinge`'s bend at `frame` in `_synthetic_run` [deg]."""
+    return 5.0 + (3.0 if hinge == 4 else 0.0) + frame / 100.0
+
+
 def test_table3_rows_on_a_hand_built_run():
     rows = {r["key"]: r for r in paper.comparison(_synthetic_run()).to_pylist()}
-    # Phases 4, 6, 5, 4: the most frequent is 4 (a rounded mean would say 5).
+    # Hinge 4 bends 3 deg more than any other on average: it is the most deformed joint, whatever the offsets say.
     assert rows["most_deformed_joint"]["ours"] == 4.0
-    # A link number is an index: no ratio against the paper's link number.
+    # A joint number is an index: no ratio against the paper's joint number.
     assert rows["most_deformed_joint"]["ratio"] is None
-    assert "per-phase most deformed links 4, 6, 5, 4: link 4 at 2 of 4 phases" in rows["most_deformed_joint"]["note"]
-    assert "tie" not in rows["most_deformed_joint"]["note"].split("per-phase")[1]
-    # Included angle at hinge k between link k and link k+1, k = 4, 6, 5, 4 at frames 3, 6, 9, 12.
-    angles = [180.0 - k - f / 100.0 for k, f in ((4, 3), (6, 6), (5, 9), (4, 12))]
-    assert rows["included_angle_min_deg"]["ours"] == pytest.approx(min(angles))
-    assert rows["included_angle_max_deg"]["ours"] == pytest.approx(max(angles))
+    note = rows["most_deformed_joint"]["note"]
+    mean = 8.0 + np.arange(13).mean() / 100.0
+    assert f"hinge 4 {mean:.2f} deg, hinge 1 {mean - 3.0:.2f} deg" in note
+    assert "margin over the runner-up 3.000 deg" in note
+    assert "the link centres furthest out at the phases: links 4, 6, 5, 4" in note
+    # Included angle at hinge 4 between link 4 and link 5 at frames 3, 6, 9, 12; in the bend plane, projected alike.
+    angles = [180.0 - _synthetic_bend(4, f) for f in (3, 6, 9, 12)]
+    for kind in ("", "projected_"):
+        assert rows[f"included_angle_{kind}min_deg"]["ours"] == pytest.approx(min(angles), abs=1e-9), kind
+        assert rows[f"included_angle_{kind}max_deg"]["ours"] == pytest.approx(max(angles), abs=1e-9), kind
     assert "hinge k between link k and link k+1" in rows["included_angle_min_deg"]["note"]
-    assert "hinges 4, 6, 5, 4 at the phases" in rows["included_angle_min_deg"]["note"]
-    # The two ranges of motion: the largest centre offset at the phases (link 6's 12 mm) and link 4's excursion
-    # over the last revolution (0-0.6 s, the whole circle: 20 mm).
-    assert rows["range_of_motion_mm"]["ours"] == pytest.approx(12.0)
+    assert "hinge 4 at every phase" in rows["included_angle_min_deg"]["note"]
+    assert rows["included_angle_projected_min_deg"]["paper"] == 172.8
+    # The two ranges of motion of link 4: its largest centre offset at the phases (10 mm on its circle) and its
+    # excursion over the last revolution (0-0.6 s, the whole circle: 20 mm).
+    assert rows["range_of_motion_mm"]["ours"] == pytest.approx(10.0)
     p2p = rows["range_of_motion_peak_to_peak_mm"]
     assert p2p["ours"] == pytest.approx(20.0)
     assert p2p["paper"] == 25.3 and p2p["ratio"] == pytest.approx(20.0 / 25.3)
@@ -427,15 +421,19 @@ def test_table3_rows_on_a_hand_built_run():
         assert rows[key]["ours"] is None and "hinges table" in rows[key]["note"], key
 
 
-def test_table3_tie_goes_to_the_largest_offset():
-    # Only the last two phases (0.45 and 0.6 s) lie in a 0.6 s run started 0.3 s late: links 5 and 4, one each.
-    run = _synthetic_run()
+def test_most_deformed_joint_follows_the_mean_bend_of_the_last_revolution():
+    # Hinge 9 bends 4 deg more than the rest, but only before the last revolution (t < 0.3 s of a 0.9 s run,
+    # whose last revolution is 0.3-0.9 s): hinge 4, the most bent over the last revolution, stays the joint, and the
+    # note names hinge 9 as the winner of the revolution before.
+    run = _synthetic_run(duration=0.9)
     links = run.tables["links"]
-    late = links.filter(pc.greater_equal(links.column("t"), 0.3 + 1e-9))
-    run = ballcage.Run({"links": late}, run.scene_toml)
-    row = {r["key"]: r for r in paper.comparison(run).to_pylist()}["most_deformed_joint"]
-    assert row["ours"] == 5.0  # 11 mm at 180° beats link 4's 10 mm at 270°
-    assert "tie between links 4, 5 (1 each): link 5 has the largest offset (11.00 mm)" in row["note"]
+    early = (links.column("link").to_numpy() == 9) & (links.column("t").to_numpy() < 0.3 - 1e-9)
+    angles = links.column("included_angle_deg").to_numpy().copy()
+    angles[early] -= 4.0
+    links = links.set_column(links.schema.get_field_index("included_angle_deg"), "included_angle_deg", pa.array(angles))
+    row = {r["key"]: r for r in paper.comparison(ballcage.Run({"links": links}, run.scene_toml)).to_pylist()}
+    assert row["most_deformed_joint"]["ours"] == 4.0
+    assert "over the revolution before 0.000-0.250 s (6 frames): hinge 9 " in row["most_deformed_joint"]["note"]
 
 
 def test_included_angle_at_hinge_k_is_180_minus_the_bend_of_hinge_k(short_run):

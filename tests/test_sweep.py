@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
 import pytest
@@ -127,9 +128,11 @@ def test_toml_values_and_parameter_units() -> None:
     assert [toml_value(v) for v in (True, 3, 0.5, "a", [1, "b"], {"x": 1.0})] == [
         "true", "3", "0.5", '"a"', '[1, "b"]', '{"x" = 1.0}'
     ]
-    text = ballcage.scene.default_scene().to_toml(units=True)
-    assert parameter_units(text, ["borehole.curvature_radius", "drive.speed_rpm", "pipe.joints", "pipe.hinge"]) == {
-        "borehole.curvature_radius": "m", "drive.speed_rpm": "rpm", "pipe.joints": "", "pipe.hinge": ""
+    scene = ballcage.scene.default_scene()
+    keys = ["borehole.curvature_radius", "drive.speed_rpm", "pipe.joints", "pipe.hinge", "materials.tube.normal.damping"]
+    assert parameter_units(scene, [*keys, "simulation.divergence.max_penetration"]) == {
+        "borehole.curvature_radius": "m", "drive.speed_rpm": "rpm", "pipe.joints": "", "pipe.hinge": "",
+        "materials.tube.normal.damping": "N·s/mm", "simulation.divergence.max_penetration": "",
     }
 
 
@@ -182,9 +185,25 @@ def test_tables_open_as_one_hive_dataset_with_a_case_column(local: ballcage.stud
 
 
 def test_other_readers_open_the_datasets(local: ballcage.studies.SweepResult) -> None:
-    polars = pytest.importorskip("polars")
-    frame = polars.scan_parquet(str(local.out / "links" / "**" / "*.parquet"), hive_partitioning=True).collect()
-    assert sorted(frame["case"].unique().to_list()) == [0, 1, 2, 3, 4]
+    """polars (in the test extra, so this runs) does what README.md and docs/studies.md show it doing.
+
+    README: ``json.loads(pl.read_parquet_metadata(FILE)["ballcage.units"])``; docs/studies.md: the
+    links as one hive dataset, each case's peak tube force joined with the summary on ``case``.
+    """
+    import polars as pl
+
+    part = local.out / "links" / "case=0000" / "part.parquet"
+    units = json.loads(pl.read_parquet_metadata(str(part))["ballcage.units"])
+    assert units == json.loads(pq.read_metadata(part).metadata[b"ballcage.units"])
+    assert units["tube_normal"] == "N" and units["t"] == "s"
+    links = pl.scan_parquet(str(local.out / "links" / "**" / "*.parquet"), hive_partitioning=True)
+    summary = pl.read_parquet(local.out / "summary.parquet")
+    peaks = links.group_by("case").agg(pl.col("tube_normal").max()).collect().join(summary, on="case").sort("case")
+    assert peaks["case"].to_list() == [0, 1, 2, 3, 4]
+    assert peaks["case_id"].to_list() == local.summary.column("case_id").to_pylist()
+    arrow = ds.dataset(local.out / "links", format="parquet", partitioning="hive").to_table()
+    for case, peak in zip(peaks["case"], peaks["tube_normal"], strict=True):
+        assert peak == max(arrow.filter(pc.equal(arrow["case"], case)).column("tube_normal").to_pylist()), case
 
 
 def test_resume_skips_finished_cases_and_reruns_missing_ones(

@@ -23,6 +23,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pyarrow.compute as pc
 import pytest
 from PIL import Image
 
@@ -188,6 +189,29 @@ def test_poses_from_bodies_match_the_links_table(run_dir: Path) -> None:
     np.testing.assert_allclose(from_bodies.centres[:, links], from_links.centres, atol=1e-9)
     assert from_bodies.lengths[1] == pytest.approx(0.2 - 0.04)
     assert from_bodies.keys is not None and from_bodies.keys.shape == (31, len(KEYS), 3)
+
+
+def test_the_view_tells_the_bodies_apart_by_their_part_ids(run_dir: Path) -> None:
+    """The bodies table says what each body is (part, link, hinge, key); the view reads those, not the names."""
+    import pyarrow.parquet as pq
+
+    bodies = pq.read_table(run_dir / "bodies.parquet")
+    first = bodies.filter(pc.equal(bodies.column("step"), 0)).to_pylist()
+    parts = {(r["part"], r["link"], r["hinge"], r["key"]) for r in first}
+    assert {p for p in parts if p[0] == "link"} == {("link", k, None, None) for k in range(1, JOINTS + 1)}
+    assert {p for p in parts if p[0] == "key"} == {("key", None, h, j) for h in range(JOINTS + 1) for j in range(6)}
+    assert {p for p in parts if p[0] in ("upper", "lower")} == {("upper", None, None, None), ("lower", None, None, None)}
+    assert len(first) == len(CHAIN) + len(KEYS)
+
+    run = read_run(run_dir)
+    assert "body" not in run.tables["bodies"].column_names  # names are not even read
+    chain = chain_frames(run)
+    assert chain.labels == ("upper connector", *[f"link {k}" for k in range(1, JOINTS + 1)], "lower connector")
+    assert chain.keys is not None and chain.keys.shape[1] == len(KEYS)
+    # keys in (hinge, key) order: key 0 of hinge 0 sits between the upper connector and link 1
+    upper, link1 = chain.centres[0, 0], chain.centres[0, 1]
+    key = chain.keys[0, 0]
+    assert np.linalg.norm(key - (upper + link1) / 2) < np.linalg.norm(upper - link1)
 
 
 def test_the_tube_follows_the_scene_centreline(run_dir: Path) -> None:

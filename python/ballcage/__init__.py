@@ -19,7 +19,8 @@ All quantities are SI; units are in each output column's field metadata.
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
 `ballcage.paper.run_paper(dir)` runs it and writes the tables, the paper's
 figures and a comparison with the paper's numbers (``ballcage paper``).
-`ballcage.sizing` is the paper's joint-sizing eq. (9) both ways (``ballcage size``).
+`ballcage.sizing` is the paper's link-sizing eq. (9) both ways (``ballcage size``):
+`longest_link`, `tightest_radius_for_link`, `largest_link_diameter`.
 `ballcage.studies.accuracy` and `ballcage.studies.stability` measure what
 each integrator's step costs in error and where it stops being stable
 (``ballcage accuracy``, ``ballcage stability``).
@@ -43,7 +44,7 @@ from ballcage._native import (
 from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
-from ballcage.sizing import largest_joint_diameter, longest_joint, smallest_curvature_radius
+from ballcage.sizing import largest_link_diameter, longest_link, tightest_radius_for_link
 
 __version__: str = _native.__version__
 
@@ -60,12 +61,12 @@ __all__ = [
     "SimulationError",
     "__version__",
     "buckling",
-    "largest_joint_diameter",
+    "largest_link_diameter",
     "load_scene",
-    "longest_joint",
+    "longest_link",
     "simulate",
-    "smallest_curvature_radius",
     "table_schema",
+    "tightest_radius_for_link",
 ]
 
 _DEBUG_BUILD_MESSAGE = "ballcage was built without optimizations; runs are ~10x slower: pip install . builds release"
@@ -84,6 +85,9 @@ def __getattr__(name: str) -> _Any:
     """Imports `ballcage.paper` and `ballcage.studies` (and with them matplotlib) only when first used."""
     if name in ("paper", "studies"):
         return _importlib.import_module(f"ballcage.{name}")
+    if name in ("longest_joint", "smallest_curvature_radius", "largest_joint_diameter"):
+        # eq. (9)'s names of the previous release: deprecated (a DeprecationWarning when called)
+        return getattr(_importlib.import_module("ballcage.sizing"), name)
     if name == "sweep":  # `ballcage.sweep(spec, out, client=...)`: ballcage.studies.sweep_run.sweep
         return _importlib.import_module("ballcage.studies.sweep_run").sweep
     raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

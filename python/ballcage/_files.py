@@ -12,7 +12,7 @@ if TYPE_CHECKING:
     import pyarrow as pa
     from matplotlib.figure import Figure
 
-__all__ = ["write_all_atomically", "write_atomically", "write_parquet", "write_png", "write_text"]
+__all__ = ["parquet_writer", "write_all_atomically", "write_atomically", "write_parquet", "write_png", "write_text"]
 
 
 def write_atomically(final: Path, write: Callable[[Path], object]) -> None:
@@ -97,11 +97,20 @@ def _naming(error: OSError, tmp: Path, final: Path) -> OSError | None:
     return named
 
 
-def write_parquet(table: pa.Table, path: Path) -> Path:
-    """Writes `table` to `path` as zstd-compressed Parquet, atomically; returns `path`."""
-    import pyarrow.parquet as pq  # deferred: only writers pay for it
+def parquet_writer(table: pa.Table) -> Callable[[Path], None]:
+    """The one Parquet writer (zstd-compressed) of `table`: fills the path it is given, for `write_atomically`."""
 
-    write_atomically(path, lambda tmp: pq.write_table(table, str(tmp), compression="zstd"))
+    def write(tmp: Path) -> None:
+        import pyarrow.parquet as pq  # deferred: only writers pay for it
+
+        pq.write_table(table, str(tmp), compression="zstd")
+
+    return write
+
+
+def write_parquet(table: pa.Table, path: Path) -> Path:
+    """Writes `table` to `path` as zstd-compressed Parquet (`parquet_writer`), atomically; returns `path`."""
+    write_atomically(path, parquet_writer(table))
     return path
 
 

@@ -27,11 +27,12 @@ __all__ = [
     "whole_multiple",
     "longest_link",
     "tightest_radius_for_link",
-    "largest_link_radius",
+    "largest_link_diameter",
     "tightest_radius_for_bend",
 ]
 
-_TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive", "pairs"]
+#: Every table name `TABLE_NAMES` holds, in its order (tests/test_units.py keeps the two equal).
+_TableName = Literal["bodies", "contacts", "energy", "summary", "links", "hinges", "keys", "drive", "pairs", "wear"]
 
 __version__: str
 #: Cargo profile the extension was built with; "debug" runs ~10x slower.
@@ -119,6 +120,33 @@ class Scene:
     @property
     def kind(self) -> Literal["generic", "drill-pipe"]:
         """The scene kind: a generic scene of bodies and pairs, or a drill pipe expanded into one."""
+
+    @property
+    def integrated_bodies(self) -> list[str]:
+        """Names of the bodies the integrator moves (motion ``dynamic`` or ``spin``), in body order; a drill pipe's expanded ones."""
+
+    def unit(self, key: str) -> str:
+        """The unit of the field at a dotted key, as ``to_toml(units=True)`` prints it.
+
+        E.g. ``"m"`` for ``"borehole.curvature_radius"``, ``"rpm"`` for ``"drive.speed_rpm"``;
+        ``"-"`` for a pure number and ``""`` for text, booleans and tables. Keys as in
+        `value` (``"bodies[1].mass"`` or ``"bodies.1.mass"``; an element of an array of
+        numbers answers as its array). A contact law's field answers in the law's own
+        ``units``: ``"N/mm^2.2"`` for the paper's tube law stiffness. From the engine's one
+        table of field units. Raises `InputError` naming the key when the scene has no
+        such field.
+        """
+
+    def meaning(self, key: str) -> str:
+        """One line on what the field at a dotted key is (keys as in `unit`). Raises `InputError` naming an unknown key."""
+
+    def scale_from(self, key: str, units: Literal["SI", "N-mm-s"]) -> float:
+        """The factor that turns a value of the contact-law field `key`, written in `units`, into the
+        law's own units (those `unit` names): ``1000**n`` for a stiffness K [N/mm^n] of a law written
+        in SI, ``1.0`` when the units are the law's own.
+
+        Raises `InputError` for a key that is not a number of a contact law, or other `units`.
+        """
 
     def value(self, key: str) -> Any:
         """The resolved value at a dotted key of the scene document, e.g. ``"pipe.ball_keys.ball_mass"``.
@@ -211,20 +239,20 @@ def whole_multiple(interval: float, step: float) -> int | None:
 def default_scene_toml() -> str:
     """The embedded default scene (the paper's drill pipe, ``kind = "drill-pipe"``) as TOML, every default written out."""
 
-def longest_link(curvature_radius: float, tube_diameter: float, link_radius: float) -> float:
-    """The paper's eq. (9): the longest rigid link [m] of radius `link_radius` [m] that fits a tube of
-    inner diameter `tube_diameter` [m] bent to centreline radius `curvature_radius` [m],
-    L = 2·√(2(D − 2r)(R + r)). Use `ballcage.sizing` (diameters, argument checks).
+def longest_link(curvature_radius: float, tube_inner_diameter: float, link_outer_diameter: float) -> float:
+    """The paper's eq. (9): the longest rigid link [m] of outer diameter `link_outer_diameter` [m] that fits
+    a tube of inner diameter `tube_inner_diameter` [m] bent to centreline radius `curvature_radius` [m],
+    L = 2·√(2(D − 2r)(R + r)), r = d/2. Use `ballcage.sizing` (same names, argument checks).
     """
 
-def tightest_radius_for_link(length: float, tube_diameter: float, link_radius: float) -> float:
-    """Eq. (9) solved for R: the tightest centreline radius [m] a rigid link of `length` [m] fits,
+def tightest_radius_for_link(link_length: float, tube_inner_diameter: float, link_outer_diameter: float) -> float:
+    """Eq. (9) solved for R: the tightest centreline radius [m] a rigid link `link_length` [m] long fits,
     R = (L/2)² / (2(D − 2r)) − r; ``inf`` when the link does not fit the straight tube.
     """
 
-def largest_link_radius(length: float, curvature_radius: float, tube_diameter: float) -> float | None:
-    """Eq. (9) solved for r: the largest radius [m] of a rigid link of `length` [m] that fits,
-    r = (D − 2R + √((2R + D)² − L²)) / 4; ``None`` when no link that long fits, L > 2·√(2RD).
+def largest_link_diameter(link_length: float, curvature_radius: float, tube_inner_diameter: float) -> float | None:
+    """Eq. (9) solved for d: the largest outer diameter [m] of a rigid link `link_length` [m] long that fits,
+    d = 2r = (D − 2R + √((2R + D)² − L²)) / 2; ``None`` when no link that long fits, L > 2·√(2RD).
     """
 
 def tightest_radius_for_bend(pitch: float, bend_limit: float) -> float:

@@ -24,8 +24,9 @@ torques in N·m, forces in N, lengths in m, stiffness in N·m/rad.
     >>> ballcage.buckling(bending_stiffness=3400.0).threshold > 1800.0
     True
 
-``ballcage buckling`` prints the same from the command line, and with
-``--simulate`` checks it against three quasi-static runs (`simulate_check`).
+``ballcage buckling`` (`ballcage.cli.buckling`) prints the same from the
+command line, and with ``--simulate`` checks it against three quasi-static
+runs (`simulate_check`).
 """
 
 from __future__ import annotations
@@ -33,13 +34,10 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene, load_scene
-
-if TYPE_CHECKING:
-    import argparse
 
 __all__ = ["Buckling", "HingeDrive", "SimulatedTorque", "buckling", "end_wall_force", "simulate_check"]
 
@@ -284,52 +282,3 @@ def _dist(a: tuple[float, float], b: tuple[float, float]) -> float:
 
 def _dot(a: tuple[float, float], b: tuple[float, float]) -> float:
     return a[0] * b[0] + a[1] * b[1]
-
-
-def add_command(commands: Any) -> None:
-    """Registers ``ballcage buckling`` on the CLI's subcommands (`ballcage.cli`)."""
-    parser = commands.add_parser(
-        "buckling",
-        help="torque above which a drill-pipe chain leaves the arc of its tube (docs/buckling.md)",
-        description=(
-            "Print the torque [N·m] above which the chain of a drill-pipe scene (default: the paper's) "
-            "leaves the arc of its tube, with every term used (SI). --simulate checks it against quasi-static "
-            "runs (drive held, torque ramped) at a fifth of, at, and five times the threshold."
-        ),
-    )
-    parser.add_argument("scene", nargs="?", help="scene TOML file (default: the embedded paper scene)")
-    parser.add_argument("--set", metavar="KEY=VALUE", action="append", default=[], dest="overrides",
-                        help="override a scene field, e.g. --set 'pipe.hinge=\"ideal-cv\"' --set pipe.joints=3")
-    for option, unit, what in (
-        ("--friction-moment", "N·m", "static friction moment each hinge opposes to bending"),
-        ("--bending-stiffness", "N·m/rad", "bending stiffness of each hinge"),
-        ("--axial-tension", "N", "axial tension along the chain (compression negative)"),
-    ):
-        parser.add_argument(option, type=float, default=0.0, metavar=unit, help=f"{what} [{unit}] (default 0)")
-    parser.add_argument("--simulate", action="store_true", help="also run the three-torque check (seconds to minutes)")
-    parser.set_defaults(command=_cli)
-
-
-def _cli(args: argparse.Namespace) -> int:
-    from ballcage.cli import UsageError, _load_cli_scene
-
-    scene = _load_cli_scene(args.scene, args.overrides)
-    try:
-        result = buckling(
-            scene,
-            friction_moment=args.friction_moment,
-            bending_stiffness=args.bending_stiffness,
-            axial_tension=args.axial_tension,
-        )
-    except ValueError as e:
-        raise UsageError(str(e)) from e
-    print(result)
-    if args.simulate:
-        if not 0.0 < result.threshold < math.inf:
-            raise UsageError(f"threshold = {result.threshold} N·m: --simulate needs a finite, positive threshold")
-        torques = [result.threshold / 5.0, result.threshold, 5.0 * result.threshold]
-        print("\ntorque [N·m]  mean bend [deg]  max bend [deg]  wall force [N]  lateral offset [mm]")
-        for r in simulate_check(scene, torques):
-            print(f"{r.torque:12.4g}  {r.mean_bend_deg:15.3f}  {r.max_bend_deg:14.3f}  {r.wall_force:14.4g}  "
-                  f"{1e3 * r.lateral_offset:19.3f}")
-    return 0

@@ -133,7 +133,7 @@ def write_loss_figure(wear: pa.Table, path: str | os.PathLike[str]) -> Path:
         ax.bar(positions, heights, bottom=bottom, color=style["color"], label=f"{group} {sum(heights):.0f} W")
         bottom = [b + h for b, h in zip(bottom, heights, strict=True)]
     start, end = rows[0]["window_start"], rows[0]["window_end"]
-    ax.set_xlabel("position k: link k (tube) and hinge k (0 above link 1)")
+    ax.set_xlabel("position k [-]: link k (tube) and hinge k (0 above link 1)")
     ax.set_ylabel("mean friction power [W]")
     ax.set_title(f"Where the power goes: friction loss by contact, t = {start:g}–{end:g} s")
     ax.set_xticks(positions)

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
 from ballcage import _native
-from ballcage._files import write_all_atomically
+from ballcage._files import parquet_writer, write_all_atomically
 from ballcage.scene import SceneSource, load_scene
 
 if TYPE_CHECKING:
@@ -111,19 +111,13 @@ class Run:
         removed afterwards, so the folder never mixes two runs; other files
         are left alone. Returns the written paths, keyed by table name and ``"scene"``.
         """
-        import pyarrow.parquet as pq  # deferred: only writers pay for it
-
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
         written: dict[str, Path] = {}
         writers: dict[Path, Callable[[Path], object]] = {}
         for name, table in self.tables.items():
             path = out / f"{name}.parquet"
-
-            def write_parquet(tmp: Path, table: pa.Table = table) -> None:
-                pq.write_table(table, str(tmp), compression="zstd")
-
-            writers[path] = write_parquet
+            writers[path] = parquet_writer(table)
             written[name] = path
         scene_path = out / "scene.toml"
         writers[scene_path] = lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8")

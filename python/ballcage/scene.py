@@ -27,7 +27,15 @@ from typing import Any, Self, TypeAlias
 from ballcage import _native
 from ballcage._native import InputError
 
-__all__ = ["DrillPipeBuilder", "SceneBuilder", "SceneSource", "default_scene", "default_scene_toml", "load_scene"]
+__all__ = [
+    "DrillPipeBuilder",
+    "SceneBuilder",
+    "SceneSource",
+    "default_scene",
+    "default_scene_toml",
+    "load_scene",
+    "override_list",
+]
 
 
 class SceneBuilder:
@@ -213,9 +221,7 @@ def load_scene(source: SceneSource, overrides: Iterable[str] = ()) -> _native.Sc
     an error in a file starts with the file's path: ``bad.toml: TOML syntax
     error at line 2, column 7: …`` or ``bad.toml: scene field `…` = …: …``.
     """
-    if isinstance(overrides, str):
-        raise InputError("overrides is a list of 'key=value' strings, not one string")
-    patches = list(overrides)
+    patches = override_list(overrides)
     if isinstance(source, _native.Scene):
         return _native.Scene.from_toml(source.to_toml(), patches) if patches else source
     if isinstance(source, (SceneBuilder, DrillPipeBuilder)):
@@ -246,9 +252,19 @@ def default_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     (``"drive.speed_rpm=60"``, ``"simulation.duration=0.02"``), not the
     expanded scene that ``Scene.to_toml()`` returns. Raises `ballcage.SceneError`.
     """
+    return _native.Scene.from_toml(_native.default_scene_toml(), override_list(overrides))
+
+
+def override_list(overrides: Iterable[str]) -> list[str]:
+    """`overrides` (``dotted.key=value`` strings) as a list; `ballcage.InputError` for a single string.
+
+    A single string is a common slip (``overrides="a=1"``) that would
+    otherwise be read one character at a time; every function that takes
+    overrides passes them through here.
+    """
     if isinstance(overrides, str):
         raise InputError("overrides is a list of 'key=value' strings, not one string")
-    return _native.Scene.from_toml(_native.default_scene_toml(), list(overrides))
+    return list(overrides)
 
 
 def _read_scene_file(source: str | os.PathLike[str]) -> str:

@@ -22,6 +22,7 @@ use std::time::{Duration, Instant};
 use ballcage_bench::rapier_chain::{
     BallcageTubeForces, BoreMesh, RapierChain, RapierOptions, WindowMean, paper_ideal_cv,
 };
+use ballcage_core::{Document, Scene};
 
 struct Args {
     joints: Option<usize>,
@@ -67,7 +68,26 @@ fn parse() -> Args {
 
 fn main() {
     let args = parse();
-    // ballcage records a frame at whole multiples of the step; none is kept.
+    let overrides = overrides(&args);
+    let doc = paper_ideal_cv(&overrides).unwrap_or_else(|e| panic!("{e}"));
+    let scene = doc.scene();
+    let window = (args.window_start, args.duration);
+    print_header(scene, &args, &overrides, window);
+    let bc = run_ballcage(&doc, window);
+    if args.ballcage_only {
+        print_ballcage_only(&bc);
+        return;
+    }
+    let ra = run_rapier(scene, &args, window);
+    print_rapier_world(scene, &args, &ra);
+    print_timing(&bc, &ra);
+    print_forces(&bc, &ra, window);
+}
+
+/// ballcage's overrides: the step, the duration, an output interval that
+/// keeps no frame (ballcage records at whole multiples of the step), the
+/// number of joints and the `--set` ones.
+fn overrides(args: &Args) -> Vec<String> {
     let output = args.dt * (1e-3 / args.dt).ceil().max(1.0);
     let mut overrides = vec![
         format!("simulation.dt={}", args.dt),
@@ -78,9 +98,11 @@ fn main() {
         overrides.push(format!("pipe.joints={n}"));
     }
     overrides.extend(args.extra.iter().cloned());
-    let doc = paper_ideal_cv(&overrides).unwrap_or_else(|e| panic!("{e}"));
-    let scene = doc.scene();
-    let window = (args.window_start, args.duration);
+    overrides
+}
+
+/// The scene, the overrides, the step and the averaging window [s].
+fn print_header(scene: &Scene, args: &Args, overrides: &[String], window: (f64, f64)) {
     println!("scene: {}", scene.name);
     println!("overrides: pipe.hinge=\"ideal-cv\" {}", overrides.join(" "));
     println!(
@@ -91,64 +113,99 @@ fn main() {
         window.0,
         window.1
     );
+}
 
-    // ballcage.
-    let tube = BallcageTubeForces::new(scene);
+/// ballcage's run: the window means (each link's tube normal force, then
+/// the magnitude sum of its friction forces [N]), the wall time of its
+/// `step` calls, the error that stopped it if any, and where it got to.
+struct BallcageRun {
+    mean: WindowMean,
+    wall: Duration,
+    error: Option<String>,
+    time: f64,
+    steps: u64,
+}
+
+/// Runs ballcage on `doc` to its end (or its first error), sampling the
+/// tube forces in `window` [s].
+fn run_ballcage(doc: &Document, window: (f64, f64)) -> BallcageRun {
+    let tube = BallcageTubeForces::new(doc.scene());
     let mut sim = doc.simulation();
-    let mut bc_mean = WindowMean::new(window.0, window.1);
-    let mut bc_wall = Duration::ZERO;
-    let mut bc_error = None;
+    let mut mean = WindowMean::new(window.0, window.1);
+    let mut wall = Duration::ZERO;
+    let mut error = None;
     while !sim.is_done() {
         let t0 = Instant::now();
         let r = sim.step();
-        bc_wall += t0.elapsed();
+        wall += t0.elapsed();
         if let Err(e) = r {
-            bc_error = Some(e.to_string());
+            error = Some(e.to_string());
             break;
         }
-        if bc_mean.wants(sim.time()) {
+        if mean.wants(sim.time()) {
             let (normal, tangential) = tube.sample_with_friction(&mut sim);
             let mut s = normal;
             s.extend(tangential);
-            bc_mean.add(sim.time(), &s);
+            mean.add(sim.time(), &s);
         }
     }
-    let bc_time = sim.time();
-    if args.ballcage_only {
-        if let Some(e) = &bc_error {
-            println!("ballcage STOPPED at t = {bc_time:.4} s: {e}");
-        }
-        println!(
-            "ballcage: {:.3} s wall for {bc_time:.3} s simulated, real-time factor {:.3}",
-            bc_wall.as_secs_f64(),
-            bc_time / bc_wall.as_secs_f64()
-        );
-        let b = bc_mean.means();
-        let n = b.len() / 2;
-        println!("| link | ballcage [N] | ballcage μ_eff |\n|---|---:|---:|");
-        for k in 0..n {
-            println!(
-                "| link{:02} | {:.1} | {:.3} |",
-                k + 1,
-                b[k],
-                b[n + k] / b[k]
-            );
-        }
-        println!("| sum | {:.1} | |", b[..n].iter().sum::<f64>());
-        return;
+    BallcageRun {
+        mean,
+        wall,
+        error,
+        time: sim.time(),
+        steps: sim.steps(),
     }
+}
 
-    // rapier.
+/// With `--ballcage-only`: ballcage's timing and its per-link forces.
+fn print_ballcage_only(bc: &BallcageRun) {
+    let bc_time = bc.time;
+    if let Some(e) = &bc.error {
+        println!("ballcage STOPPED at t = {bc_time:.4} s: {e}");
+    }
+    println!(
+        "ballcage: {:.3} s wall for {bc_time:.3} s simulated, real-time factor {:.3}",
+        bc.wall.as_secs_f64(),
+        bc_time / bc.wall.as_secs_f64()
+    );
+    let b = bc.mean.means();
+    let n = b.len() / 2;
+    println!("| link | ballcage [N] | ballcage μ_eff |\n|---|---:|---:|");
+    for k in 0..n {
+        println!(
+            "| link{:02} | {:.1} | {:.3} |",
+            k + 1,
+            b[k],
+            b[n + k] / b[k]
+        );
+    }
+    println!("| sum | {:.1} | |", b[..n].iter().sum::<f64>());
+}
+
+/// rapier's run: the world, its build time, the window means (each link's
+/// tube normal force, then the magnitude of its resultant [N]) and the wall
+/// time of its `step` calls.
+struct RapierRun {
+    chain: RapierChain,
+    build: Duration,
+    mean: WindowMean,
+    wall: Duration,
+}
+
+/// Builds rapier's world of `scene` and runs it for the duration, sampling
+/// the tube forces in `window` [s].
+fn run_rapier(scene: &Scene, args: &Args, window: (f64, f64)) -> RapierRun {
     let t_build = Instant::now();
     let mut chain = RapierChain::from_scene(scene, &args.options).unwrap_or_else(|e| panic!("{e}"));
     let build = t_build.elapsed();
-    let mut ra_mean = WindowMean::new(window.0, window.1);
-    let mut ra_wall = Duration::ZERO;
+    let mut mean = WindowMean::new(window.0, window.1);
+    let mut wall = Duration::ZERO;
     while chain.time() < args.duration - 1e-9 {
         let t0 = Instant::now();
         chain.step();
-        ra_wall += t0.elapsed();
-        if ra_mean.wants(chain.time()) {
+        wall += t0.elapsed();
+        if mean.wants(chain.time()) {
             let mut s = chain.tube_normal_forces();
             s.extend(
                 chain
@@ -156,10 +213,20 @@ fn main() {
                     .iter()
                     .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt()),
             );
-            ra_mean.add(chain.time(), &s);
+            mean.add(chain.time(), &s);
         }
     }
+    RapierRun {
+        chain,
+        build,
+        mean,
+        wall,
+    }
+}
 
+/// rapier's world: the mesh, its chord errors, μ, the bend limit, substeps.
+fn print_rapier_world(scene: &Scene, args: &Args, ra: &RapierRun) {
+    let chain = &ra.chain;
     let (r, big_r) = tube_size(scene);
     let (e_around, e_along) = args.options.mesh.chord_errors(r, big_r);
     println!(
@@ -173,26 +240,31 @@ fn main() {
         chain.friction(),
         chain.bend_limit().unwrap_or(f64::NAN).to_degrees(),
         args.options.substeps,
-        build.as_secs_f64()
+        ra.build.as_secs_f64()
     );
-    if let Some(e) = &bc_error {
+}
+
+/// Each engine's wall time, real-time factor and their ratio.
+fn print_timing(bc: &BallcageRun, ra: &RapierRun) {
+    let (bc_time, chain) = (bc.time, &ra.chain);
+    if let Some(e) = &bc.error {
         println!("ballcage STOPPED at t = {bc_time:.4} s: {e}");
     }
     let rtf = |sim_t: f64, wall: Duration| sim_t / wall.as_secs_f64();
-    let (bw, rw) = (bc_wall.as_secs_f64(), ra_wall.as_secs_f64());
+    let (bw, rw) = (bc.wall.as_secs_f64(), ra.wall.as_secs_f64());
     println!(
         "ballcage: {:>8.3} s wall for {:.3} s simulated ({} steps), real-time factor {:.3}",
         bw,
         bc_time,
-        sim.steps(),
-        rtf(bc_time, bc_wall)
+        bc.steps,
+        rtf(bc_time, bc.wall)
     );
     println!(
         "rapier:   {:>8.3} s wall for {:.3} s simulated ({} steps), real-time factor {:.3}",
         rw,
         chain.time(),
         chain.steps(),
-        rtf(chain.time(), ra_wall)
+        rtf(chain.time(), ra.wall)
     );
     let ratio = (bw / bc_time) / (rw / chain.time());
     println!(
@@ -203,11 +275,15 @@ fn main() {
             format!("ballcage {:.2}x faster", 1.0 / ratio)
         }
     );
+}
 
-    let names = chain.link_names();
+/// The table of each link's mean tube normal force in both engines over
+/// `window` [s].
+fn print_forces(bc: &BallcageRun, ra: &RapierRun, window: (f64, f64)) {
+    let names = ra.chain.link_names();
     let n = names.len();
-    let (b, ra) = (bc_mean.means(), ra_mean.means());
-    if b.is_empty() || ra.is_empty() {
+    let (b, r) = (bc.mean.means(), ra.mean.means());
+    if b.is_empty() || r.is_empty() {
         println!("no samples in the window");
         return;
     }
@@ -215,8 +291,8 @@ fn main() {
         "\nmean tube normal force per link over [{}, {}] s ({} ballcage and {} rapier samples):",
         window.0,
         window.1,
-        bc_mean.count(),
-        ra_mean.count()
+        bc.mean.count(),
+        ra.mean.count()
     );
     println!(
         "| link | ballcage [N] | rapier [N] | rapier/ballcage − 1 | rapier resultant [N] | ballcage μ_eff |"
@@ -233,13 +309,13 @@ fn main() {
             "| {} | {:.1} | {:.1} | {:+.1} % | {:.1} | {:.3} |",
             names[k],
             b[k],
-            ra[k],
-            (ra[k] / b[k] - 1.0) * 100.0,
-            ra[n + k],
+            r[k],
+            (r[k] / b[k] - 1.0) * 100.0,
+            r[n + k],
             mu
         );
         sb += b[k];
-        sr += ra[k];
+        sr += r[k];
     }
     println!(
         "| sum | {:.1} | {:.1} | {:+.1} % | | {:.3} |",
@@ -251,7 +327,7 @@ fn main() {
 }
 
 /// The tube's inner radius and its tightest arc radius [m].
-fn tube_size(scene: &ballcage_core::Scene) -> (f64, f64) {
+fn tube_size(scene: &Scene) -> (f64, f64) {
     use ballcage_core::scene::{ShapeSpec, TubeSegmentSpec};
     for b in &scene.bodies {
         if let ShapeSpec::Tube {

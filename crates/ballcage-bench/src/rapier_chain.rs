@@ -127,9 +127,9 @@ use ballcage_core::Simulation;
 use ballcage_core::geometry::Shape;
 use ballcage_core::model::SpinProfile;
 use ballcage_core::scene::{
-    FeatureSpec, JointSpec, LoadSpec, MotionKind, ShapeSpec, TubeSegmentSpec,
+    BodySpec, FeatureSpec, JointSpec, LoadSpec, MotionKind, ShapeSpec, TubeSegmentSpec,
 };
-use ballcage_core::{Scene, SceneError};
+use ballcage_core::{Model, Scene, SceneError};
 use ballcage_shapes::ShapeDispatcher;
 use rapier3d_f64::parry::query::{DefaultQueryDispatcher, QueryDispatcher};
 use rapier3d_f64::prelude::*;
@@ -281,179 +281,320 @@ fn err(path: &str, reason: impl Into<String>) -> SceneError {
     SceneError::new(path, "", reason.into())
 }
 
-impl RapierChain {
-    /// Builds the rapier world of `scene` (a drill pipe with the ideal-CV
-    /// hinge, or any scene of the same parts: one fixed `tube` body, links
-    /// in declared pairs with it, `cv` joints, `kinematic-spin` and `spin`
-    /// bodies, `torque` loads). Refuses parts it has no rapier model for.
-    pub fn from_scene(scene: &Scene, options: &RapierOptions) -> Result<Self, SceneError> {
-        let (model, _) = ballcage_core::assembly::assemble(scene)?;
-        let mut bodies = RigidBodySet::new();
-        let mut colliders = ColliderSet::new();
-        let mut impulse_joints = ImpulseJointSet::new();
-        let ground = bodies.insert(RigidBodyBuilder::fixed().build());
+/// The index of the scene's tube body (the bore).
+fn tube_body(scene: &Scene) -> Result<usize, SceneError> {
+    scene
+        .bodies
+        .iter()
+        .position(|b| matches!(b.shape, ShapeSpec::Tube { .. }))
+        .ok_or_else(|| err("bodies", "the scene has no tube body"))
+}
 
-        let tube_id = scene
-            .bodies
-            .iter()
-            .position(|b| matches!(b.shape, ShapeSpec::Tube { .. }))
-            .ok_or_else(|| err("bodies", "the scene has no tube body"))?;
-        // Links: the bodies in declared pairs with the tube, in pair order.
-        let mut link_ids = Vec::new();
-        let mut tube_pairs = Vec::new();
-        for (k, c) in scene.contacts.iter().enumerate() {
-            let tube = &scene.bodies[tube_id].name;
-            if c.bodies[0] == *tube || c.bodies[1] == *tube {
-                let other = if c.bodies[0] == *tube {
-                    &c.bodies[1]
-                } else {
-                    &c.bodies[0]
-                };
-                let id = scene
-                    .body_index(other)
-                    .ok_or_else(|| err("contacts", "unknown body"))?;
-                link_ids.push(id);
-                tube_pairs.push(k);
-            }
-        }
-        // The drive speed and the link radius fix the default friction coefficient.
-        let drive_speed = scene
-            .bodies
-            .iter()
-            .filter(|b| b.motion == MotionKind::KinematicSpin)
-            .map(|b| b.spin_speed.abs())
-            .fold(0.0, f64::max);
-        let link_radius = link_ids
-            .iter()
-            .map(|&i| match scene.bodies[i].shape {
-                ShapeSpec::Cylinder { radius, .. } => radius,
-                _ => 0.0,
-            })
-            .fold(0.0, f64::max);
-        let friction = match options.friction {
-            Some(mu) => mu,
-            None => tube_pairs
-                .first()
-                .and_then(|&k| model.pairs[k].friction)
-                .map_or(0.0, |law| law.coefficient(drive_speed * link_radius).mu),
-        };
-
-        let mut handles = HashMap::new();
-        let mut links = Vec::new();
-        let mut drives = Vec::new();
-        for (i, b) in scene.bodies.iter().enumerate() {
-            let pose = Pose::from_parts(v3(b.position), quat(b.orientation));
-            let handle = match b.motion {
-                MotionKind::Fixed => bodies.insert(RigidBodyBuilder::fixed().pose(pose).build()),
-                MotionKind::KinematicSpin => {
-                    let axis = v3(b.spin_axis.ok_or_else(|| {
-                        err(
-                            &format!("bodies[{i}].spin_axis"),
-                            "a drive needs a spin axis",
-                        )
-                    })?)
-                    .normalize();
-                    let (m, inertia) = b.mass_properties().unwrap_or((1.0, [1.0; 3]));
-                    let h = bodies.insert(
-                        RigidBodyBuilder::kinematic_position_based()
-                            .pose(pose)
-                            .additional_mass_properties(MassProperties::new(
-                                Vector::ZERO,
-                                m,
-                                v3(inertia),
-                            ))
-                            .can_sleep(false)
-                            .build(),
-                    );
-                    let profile = SpinProfile {
-                        axis: ballcage_core::math::Vec3::new(axis.x, axis.y, axis.z),
-                        speed: b.spin_speed,
-                        ramp: b.spin_ramp,
-                    };
-                    drives.push((h, profile, pose.rotation));
-                    h
-                }
-                MotionKind::Dynamic | MotionKind::Spin => {
-                    let (m, inertia) = b.mass_properties().ok_or_else(|| {
-                        err(
-                            &format!("bodies[{i}]"),
-                            "a moving body needs mass properties",
-                        )
-                    })?;
-                    let h = bodies.insert(
-                        RigidBodyBuilder::dynamic()
-                            .pose(pose)
-                            .additional_mass_properties(MassProperties::new(
-                                Vector::ZERO,
-                                m,
-                                v3(inertia),
-                            ))
-                            .linvel(v3(b.velocity))
-                            .angvel(v3(b.angular_velocity))
-                            .can_sleep(false)
-                            .build(),
-                    );
-                    if b.motion == MotionKind::Spin {
-                        let axis = v3(b.spin_axis.ok_or_else(|| {
-                            err(
-                                &format!("bodies[{i}].spin_axis"),
-                                "a spin body needs an axis",
-                            )
-                        })?)
-                        .normalize();
-                        let bearing = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
-                            .local_axis1(axis)
-                            .local_axis2(pose.rotation.inverse() * axis)
-                            .local_anchor1(pose.translation)
-                            .local_anchor2(Vector::ZERO)
-                            .contacts_enabled(false)
-                            .build();
-                        impulse_joints.insert(ground, h, bearing, true);
-                    }
-                    h
-                }
+/// The links, the bodies in declared pairs with the tube `tube_id`, and
+/// those pairs, both in pair order: (link body indices, pair indices).
+fn tube_links(scene: &Scene, tube_id: usize) -> Result<(Vec<usize>, Vec<usize>), SceneError> {
+    let mut link_ids = Vec::new();
+    let mut tube_pairs = Vec::new();
+    for (k, c) in scene.contacts.iter().enumerate() {
+        let tube = &scene.bodies[tube_id].name;
+        if c.bodies[0] == *tube || c.bodies[1] == *tube {
+            let other = if c.bodies[0] == *tube {
+                &c.bodies[1]
+            } else {
+                &c.bodies[0]
             };
-            handles.insert(b.name.clone(), handle);
+            let id = scene
+                .body_index(other)
+                .ok_or_else(|| err("contacts", "unknown body"))?;
+            link_ids.push(id);
+            tube_pairs.push(k);
+        }
+    }
+    Ok((link_ids, tube_pairs))
+}
+
+/// The Coulomb coefficient of the link–bore contacts [–]: the options' own,
+/// or the first tube pair's friction law at the slip speed ω₀·r_link (the
+/// fastest drive's speed times the largest link radius).
+fn link_friction(
+    scene: &Scene,
+    model: &Model,
+    options: &RapierOptions,
+    link_ids: &[usize],
+    tube_pairs: &[usize],
+) -> f64 {
+    let drive_speed = scene
+        .bodies
+        .iter()
+        .filter(|b| b.motion == MotionKind::KinematicSpin)
+        .map(|b| b.spin_speed.abs())
+        .fold(0.0, f64::max);
+    let link_radius = link_ids
+        .iter()
+        .map(|&i| match scene.bodies[i].shape {
+            ShapeSpec::Cylinder { radius, .. } => radius,
+            _ => 0.0,
+        })
+        .fold(0.0, f64::max);
+    match options.friction {
+        Some(mu) => mu,
+        None => tube_pairs
+            .first()
+            .and_then(|&k| model.pairs[k].friction)
+            .map_or(0.0, |law| law.coefficient(drive_speed * link_radius).mu),
+    }
+}
+
+/// The unit spin axis [–] of body `i`, or an error with `reason` if it has none.
+fn spin_axis(i: usize, b: &BodySpec, reason: &str) -> Result<Vector, SceneError> {
+    let axis = b
+        .spin_axis
+        .ok_or_else(|| err(&format!("bodies[{i}].spin_axis"), reason))?;
+    Ok(v3(axis).normalize())
+}
+
+/// Mass [kg] and principal inertia [kg·m²] about the centre of mass.
+fn mass_properties(mass: f64, inertia: [f64; 3]) -> MassProperties {
+    MassProperties::new(Vector::ZERO, mass, v3(inertia))
+}
+
+/// Refuses feature pairs other than the neck–mouth ones: the ball keys have
+/// no rapier model here.
+fn reject_ball_keys(scene: &Scene) -> Result<(), SceneError> {
+    match scene.contacts.iter().position(|c| {
+        c.geometry.is_some() && !matches!(c.geometry, Some(FeatureSpec::RingCylinder { .. }))
+    }) {
+        Some(j) => Err(err(
+            &format!("contacts[{j}]"),
+            "the rapier baseline models the ideal-CV hinge only (no ball keys)",
+        )),
+        None => Ok(()),
+    }
+}
+
+/// The hinge of `cv` joint `joint`: a spherical joint with the twist locked,
+/// its bend under the neck–mouth cone limit [rad] if the scene declares one.
+fn hinge(scene: &Scene, joint: &JointSpec) -> (GenericJoint, Option<f64>) {
+    let JointSpec::Cv {
+        bodies: names,
+        anchors,
+        ..
+    } = joint;
+    let mut builder = GenericJointBuilder::new(JointAxesMask::LIN_AXES | JointAxesMask::ANG_X)
+        .local_anchor1(v3(anchors[0]))
+        .local_anchor2(v3(anchors[1]))
+        .contacts_enabled(false);
+    let limit = neck_limit(scene, names, anchors);
+    if let Some(limit) = limit {
+        builder = builder
+            .coupled_axes(JointAxesMask::ANG_Y | JointAxesMask::ANG_Z)
+            .limits(JointAxis::AngY, [-limit, limit]);
+    }
+    (builder.build(), limit)
+}
+
+/// rapier's integration parameters for `scene`'s step [s] and the options.
+fn integration_parameters(scene: &Scene, options: &RapierOptions) -> IntegrationParameters {
+    IntegrationParameters {
+        dt: scene.simulation.dt,
+        length_unit: options.length_unit,
+        contact_recycling: false,
+        // See "The exact bore" in the module doc.
+        contact_clustering: options.bore == Bore::Mesh,
+        num_solver_iterations: options.substeps,
+        ..IntegrationParameters::default()
+    }
+}
+
+/// The narrow phase of the bore: rapier's own for the mesh, ballcage's
+/// shapes chained before it for the exact tube.
+fn narrow_phase(options: &RapierOptions) -> NarrowPhase {
+    match options.bore {
+        Bore::Mesh => NarrowPhase::new(),
+        Bore::Exact { samples } => NarrowPhase::with_query_dispatcher(
+            ShapeDispatcher::with_samples(samples).chain(DefaultQueryDispatcher),
+        ),
+    }
+}
+
+/// The rapier sets of a world being built from a scene, in the order the
+/// scene declares its parts (rapier's results depend on insertion order).
+struct WorldBuilder {
+    bodies: RigidBodySet,
+    colliders: ColliderSet,
+    impulse_joints: ImpulseJointSet,
+    /// The fixed body the bearings hold on to.
+    ground: RigidBodyHandle,
+    /// Each scene body's rapier body, by name.
+    handles: HashMap<String, RigidBodyHandle>,
+    /// The drives: body, prescribed spin and initial rotation.
+    drives: Vec<(RigidBodyHandle, SpinProfile, Rotation)>,
+}
+
+impl WorldBuilder {
+    /// Empty sets but for the ground.
+    fn new() -> Self {
+        let mut bodies = RigidBodySet::new();
+        let ground = bodies.insert(RigidBodyBuilder::fixed().build());
+        Self {
+            bodies,
+            colliders: ColliderSet::new(),
+            impulse_joints: ImpulseJointSet::new(),
+            ground,
+            handles: HashMap::new(),
+            drives: Vec::new(),
+        }
+    }
+
+    /// Adds every scene body, and a collider of `friction` to each of the
+    /// links `link_ids`; returns the links in `link_ids` order.
+    fn add_bodies(
+        &mut self,
+        scene: &Scene,
+        link_ids: &[usize],
+        friction: f64,
+    ) -> Result<Vec<Link>, SceneError> {
+        let mut links = Vec::new();
+        for (i, b) in scene.bodies.iter().enumerate() {
+            let handle = self.add_body(i, b)?;
+            self.handles.insert(b.name.clone(), handle);
             if let Some(pos) = link_ids.iter().position(|&l| l == i) {
-                let ShapeSpec::Cylinder {
-                    radius,
-                    half_length,
-                    ..
-                } = b.shape
-                else {
-                    return Err(err(
-                        &format!("bodies[{i}].shape"),
-                        "a link in contact with the tube must be a cylinder",
-                    ));
-                };
-                // rapier's cylinder runs along its y axis, ballcage's along x.
-                let collider = ColliderBuilder::cylinder(half_length, radius)
-                    .rotation(Vector::new(0.0, 0.0, -0.5 * PI))
-                    .density(0.0)
-                    .friction(friction)
-                    .collision_groups(InteractionGroups::new(
-                        LINKS,
-                        BORE,
-                        InteractionTestMode::And,
-                    ))
-                    .build();
-                let c = colliders.insert_with_parent(collider, handle, &mut bodies);
-                links.push((
-                    pos,
-                    Link {
-                        name: b.name.clone(),
-                        body: handle,
-                        collider: c,
-                    },
-                ));
+                links.push((pos, self.add_link_collider(i, b, handle, friction)?));
             }
         }
         links.sort_by_key(|(pos, _)| *pos);
-        let links: Vec<Link> = links.into_iter().map(|(_, l)| l).collect();
+        Ok(links.into_iter().map(|(_, l)| l).collect())
+    }
 
-        // The bore.
-        let tube = &scene.bodies[tube_id];
-        let (collider, triangles) = bore_collider(tube, &model.bodies[tube_id].shape, options)?;
+    /// Adds scene body `i` as a fixed, a drive or a moving rapier body.
+    fn add_body(&mut self, i: usize, b: &BodySpec) -> Result<RigidBodyHandle, SceneError> {
+        let pose = Pose::from_parts(v3(b.position), quat(b.orientation));
+        match b.motion {
+            MotionKind::Fixed => Ok(self
+                .bodies
+                .insert(RigidBodyBuilder::fixed().pose(pose).build())),
+            MotionKind::KinematicSpin => self.add_drive(i, b, pose),
+            MotionKind::Dynamic | MotionKind::Spin => self.add_moving(i, b, pose),
+            MotionKind::SpinSlide => Err(err(
+                &format!("bodies[{i}].motion"),
+                "a spin-slide body has no rapier model here",
+            )),
+        }
+    }
+
+    /// A `kinematic-spin` body: position-based kinematic, its spin profile
+    /// kept for [`RapierChain::step`].
+    fn add_drive(
+        &mut self,
+        i: usize,
+        b: &BodySpec,
+        pose: Pose,
+    ) -> Result<RigidBodyHandle, SceneError> {
+        let axis = spin_axis(i, b, "a drive needs a spin axis")?;
+        let (m, inertia) = b.mass_properties().unwrap_or((1.0, [1.0; 3]));
+        let h = self.bodies.insert(
+            RigidBodyBuilder::kinematic_position_based()
+                .pose(pose)
+                .additional_mass_properties(mass_properties(m, inertia))
+                .can_sleep(false)
+                .build(),
+        );
+        let profile = SpinProfile {
+            axis: ballcage_core::math::Vec3::new(axis.x, axis.y, axis.z),
+            speed: b.spin_speed,
+            ramp: b.spin_ramp,
+        };
+        self.drives.push((h, profile, pose.rotation));
+        Ok(h)
+    }
+
+    /// A `dynamic` or `spin` body: dynamic, a `spin` body held to the ground
+    /// by a revolute bearing about its spin axis through its centre of mass.
+    fn add_moving(
+        &mut self,
+        i: usize,
+        b: &BodySpec,
+        pose: Pose,
+    ) -> Result<RigidBodyHandle, SceneError> {
+        let (m, inertia) = b.mass_properties().ok_or_else(|| {
+            err(
+                &format!("bodies[{i}]"),
+                "a moving body needs mass properties",
+            )
+        })?;
+        let h = self.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .pose(pose)
+                .additional_mass_properties(mass_properties(m, inertia))
+                .linvel(v3(b.velocity))
+                .angvel(v3(b.angular_velocity))
+                .can_sleep(false)
+                .build(),
+        );
+        if b.motion == MotionKind::Spin {
+            let axis = spin_axis(i, b, "a spin body needs an axis")?;
+            let bearing = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+                .local_axis1(axis)
+                .local_axis2(pose.rotation.inverse() * axis)
+                .local_anchor1(pose.translation)
+                .local_anchor2(Vector::ZERO)
+                .contacts_enabled(false)
+                .build();
+            self.impulse_joints.insert(self.ground, h, bearing, true);
+        }
+        Ok(h)
+    }
+
+    /// The cylinder collider of link body `i` (rapier's cylinder runs along
+    /// its y axis, ballcage's along x), meeting the bore only.
+    fn add_link_collider(
+        &mut self,
+        i: usize,
+        b: &BodySpec,
+        handle: RigidBodyHandle,
+        friction: f64,
+    ) -> Result<Link, SceneError> {
+        let ShapeSpec::Cylinder {
+            radius,
+            half_length,
+            ..
+        } = b.shape
+        else {
+            return Err(err(
+                &format!("bodies[{i}].shape"),
+                "a link in contact with the tube must be a cylinder",
+            ));
+        };
+        let collider = ColliderBuilder::cylinder(half_length, radius)
+            .rotation(Vector::new(0.0, 0.0, -0.5 * PI))
+            .density(0.0)
+            .friction(friction)
+            .collision_groups(InteractionGroups::new(
+                LINKS,
+                BORE,
+                InteractionTestMode::And,
+            ))
+            .build();
+        let c = self
+            .colliders
+            .insert_with_parent(collider, handle, &mut self.bodies);
+        Ok(Link {
+            name: b.name.clone(),
+            body: handle,
+            collider: c,
+        })
+    }
+
+    /// The bore's collider on the `tube` body, whose assembled shape is
+    /// `shape`, meeting the links only: (collider, mesh triangles).
+    fn add_bore(
+        &mut self,
+        tube: &BodySpec,
+        shape: &Shape,
+        options: &RapierOptions,
+        friction: f64,
+    ) -> Result<(ColliderHandle, usize), SceneError> {
+        let (collider, triangles) = bore_collider(tube, shape, options)?;
         let collider = collider
             .friction(friction)
             .collision_groups(InteractionGroups::new(
@@ -462,89 +603,93 @@ impl RapierChain {
                 InteractionTestMode::And,
             ))
             .build();
-        let bore = colliders.insert_with_parent(collider, handles[&tube.name], &mut bodies);
+        let bore =
+            self.colliders
+                .insert_with_parent(collider, self.handles[&tube.name], &mut self.bodies);
+        Ok((bore, triangles))
+    }
 
-        // Hinges, with the bend limit of their neck–mouth pair if any.
+    /// Adds the hinge of every `cv` joint; returns the bend limit [rad] of
+    /// the last one with a neck–mouth pair, if any.
+    fn add_hinges(&mut self, scene: &Scene) -> Result<Option<f64>, SceneError> {
         let mut bend_limit = None;
         for (j, joint) in scene.joints.iter().enumerate() {
-            let JointSpec::Cv {
-                bodies: names,
-                anchors,
-                ..
-            } = joint;
-            let mut builder =
-                GenericJointBuilder::new(JointAxesMask::LIN_AXES | JointAxesMask::ANG_X)
-                    .local_anchor1(v3(anchors[0]))
-                    .local_anchor2(v3(anchors[1]))
-                    .contacts_enabled(false);
-            if let Some(limit) = neck_limit(scene, names, anchors) {
-                bend_limit = Some(limit);
-                builder = builder
-                    .coupled_axes(JointAxesMask::ANG_Y | JointAxesMask::ANG_Z)
-                    .limits(JointAxis::AngY, [-limit, limit]);
-            }
-            let (a, b) = (
-                handles
-                    .get(&names[0])
-                    .ok_or_else(|| err(&format!("joints[{j}]"), "unknown body"))?,
-                handles
-                    .get(&names[1])
-                    .ok_or_else(|| err(&format!("joints[{j}]"), "unknown body"))?,
-            );
-            impulse_joints.insert(*a, *b, builder.build(), true);
+            let (hinge, limit) = hinge(scene, joint);
+            bend_limit = limit.or(bend_limit);
+            let JointSpec::Cv { bodies: names, .. } = joint;
+            let body = |name: &String| {
+                self.handles
+                    .get(name)
+                    .copied()
+                    .ok_or_else(|| err(&format!("joints[{j}]"), "unknown body"))
+            };
+            let (a, b) = (body(&names[0])?, body(&names[1])?);
+            self.impulse_joints.insert(a, b, hinge, true);
         }
-        if let Some(j) = scene.contacts.iter().position(|c| {
-            c.geometry.is_some() && !matches!(c.geometry, Some(FeatureSpec::RingCylinder { .. }))
-        }) {
+        Ok(bend_limit)
+    }
+
+    /// Each `torque` load: body, unit axis, magnitude [N·m] and ramp [s].
+    fn torques(&self, scene: &Scene) -> Vec<(RigidBodyHandle, Vector, f64, f64)> {
+        scene
+            .loads
+            .iter()
+            .filter_map(|load| match load {
+                LoadSpec::Torque {
+                    body,
+                    axis,
+                    magnitude,
+                    ramp,
+                } => Some((self.handles[body], v3(*axis).normalize(), *magnitude, *ramp)),
+                // refused by from_scene
+                LoadSpec::Force { .. } => None,
+            })
+            .collect()
+    }
+}
+
+impl RapierChain {
+    /// Builds the rapier world of `scene` (a drill pipe with the ideal-CV
+    /// hinge, or any scene of the same parts: one fixed `tube` body, links
+    /// in declared pairs with it, `cv` joints, `kinematic-spin` and `spin`
+    /// bodies, `torque` loads). Refuses parts it has no rapier model for.
+    pub fn from_scene(scene: &Scene, options: &RapierOptions) -> Result<Self, SceneError> {
+        let (model, _) = ballcage_core::assembly::assemble(scene)?;
+        let tube_id = tube_body(scene)?;
+        let (link_ids, tube_pairs) = tube_links(scene, tube_id)?;
+        let friction = link_friction(scene, &model, options, &link_ids, &tube_pairs);
+        let mut world = WorldBuilder::new();
+        let links = world.add_bodies(scene, &link_ids, friction)?;
+        let tube = &scene.bodies[tube_id];
+        let (bore, triangles) =
+            world.add_bore(tube, &model.bodies[tube_id].shape, options, friction)?;
+        let bend_limit = world.add_hinges(scene)?;
+        reject_ball_keys(scene)?;
+        if let Some(i) = (scene.loads.iter()).position(|l| matches!(l, LoadSpec::Force { .. })) {
             return Err(err(
-                &format!("contacts[{j}]"),
-                "the rapier baseline models the ideal-CV hinge only (no ball keys)",
+                &format!("loads[{i}]"),
+                "a force load has no rapier model here",
             ));
         }
-
-        let mut torques = Vec::new();
-        for load in &scene.loads {
-            let LoadSpec::Torque {
-                body,
-                axis,
-                magnitude,
-                ramp,
-            } = load;
-            torques.push((handles[body], v3(*axis).normalize(), *magnitude, *ramp));
+        let torques = world.torques(scene);
+        for (_, b) in world.bodies.iter_mut() {
+            b.recompute_mass_properties_from_colliders(&world.colliders);
         }
-
-        for (_, b) in bodies.iter_mut() {
-            b.recompute_mass_properties_from_colliders(&colliders);
-        }
-        let params = IntegrationParameters {
-            dt: scene.simulation.dt,
-            length_unit: options.length_unit,
-            contact_recycling: false,
-            // See "The exact bore" in the module doc.
-            contact_clustering: options.bore == Bore::Mesh,
-            num_solver_iterations: options.substeps,
-            ..IntegrationParameters::default()
-        };
         Ok(Self {
             gravity: v3(scene.world.gravity),
-            params,
+            params: integration_parameters(scene, options),
             pipeline: PhysicsPipeline::new(),
             islands: IslandManager::new(),
             broad_phase: BroadPhaseBvh::new(),
-            narrow_phase: match options.bore {
-                Bore::Mesh => NarrowPhase::new(),
-                Bore::Exact { samples } => NarrowPhase::with_query_dispatcher(
-                    ShapeDispatcher::with_samples(samples).chain(DefaultQueryDispatcher),
-                ),
-            },
-            bodies,
-            colliders,
-            impulse_joints,
+            narrow_phase: narrow_phase(options),
+            bodies: world.bodies,
+            colliders: world.colliders,
+            impulse_joints: world.impulse_joints,
             multibody_joints: MultibodyJointSet::new(),
             ccd: CCDSolver::new(),
             bore,
             links,
-            drives,
+            drives: world.drives,
             torques,
             friction,
             triangles,
@@ -751,7 +896,7 @@ fn neck_limit(scene: &Scene, names: &[String; 2], anchors: &[[f64; 3]; 2]) -> Op
 /// count (0 for the exact tube): the mesh of `tube`'s wall, or the exact
 /// tube of ballcage's assembled `shape` of it.
 fn bore_collider(
-    tube: &ballcage_core::scene::BodySpec,
+    tube: &BodySpec,
     shape: &Shape,
     options: &RapierOptions,
 ) -> Result<(ColliderBuilder, usize), SceneError> {

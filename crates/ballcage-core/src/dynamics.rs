@@ -51,7 +51,9 @@ pub struct ContactEval {
     pub point: ContactPoint,
     /// Penetration rate δ̇ [m/s], positive approaching.
     pub depth_rate: f64,
-    /// Normal force magnitude [N] (≥ 0).
+    /// Normal force [N] along the normal: ≥ 0, except at a point of
+    /// weight −1 (a level-set minimum of a line contact, where the point
+    /// law is subtracted from its pair's): the law times the point's weight.
     pub normal_force: f64,
     /// Tangential (friction) force on body b [N], world frame.
     pub tangential_force: Vec3,
@@ -306,8 +308,13 @@ impl Dynamics {
                     axis,
                     axis_body,
                     inertia,
+                    slides,
                 } => {
-                    acc.lin[i] = Vec3::zeros();
+                    acc.lin[i] = if slides {
+                        axis * (self.force[i].dot(&axis) / b.mass)
+                    } else {
+                        Vec3::zeros()
+                    };
                     acc.ang[i] = axis_body * (self.torque[i].dot(&axis) / inertia);
                 }
                 Motion::Fixed | Motion::KinematicSpin(_) => {}
@@ -341,6 +348,9 @@ impl Dynamics {
         }
         for l in &model.torques {
             self.torque[l.body] += l.torque(state.t);
+        }
+        for l in &model.forces {
+            self.force[l.body] += l.force(state.t);
         }
         // 2. joints
         for (n, j) in model.joints.iter().enumerate() {
@@ -523,7 +533,7 @@ pub fn pair_with_infinite_energy<'m>(model: &'m Model, state: &State) -> Option<
         find_points(model, pair, state, &mut points);
         !points
             .iter()
-            .map(|p| pair.normal.elastic_energy(p.depth))
+            .map(|p| p.weight * pair.normal.elastic_energy(p.depth))
             .sum::<f64>()
             .is_finite()
     })
@@ -544,7 +554,7 @@ pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -
         find_points(model, pair, state, points);
         potential_contact += points
             .iter()
-            .map(|p| pair.normal.elastic_energy(p.depth))
+            .map(|p| p.weight * pair.normal.elastic_energy(p.depth))
             .sum::<f64>();
     }
     Energy {
@@ -590,7 +600,8 @@ fn latch(latched: &mut [Option<f64>], state: &State, pair: &ContactPair, points:
     if latched.is_empty() {
         return;
     }
-    let mut seen = [false; 64];
+    // Slots of a pair stay below 128: 64 samples, and 2·64 − 1 for the level-set line law.
+    let mut seen = [false; 128];
     for p in points {
         let rate = depth_rate(state, pair, p);
         let slot = p.slot as usize;
@@ -675,6 +686,9 @@ fn evaluate_point_full(
         .unwrap_or(rate);
     let normal = pair.normal.evaluate(p.depth, rate, approach);
     let fnormal = normal.force;
+    // A point entering its pair with weight w (−1 at a level-set minimum,
+    // geometry::LineLaw) carries w times its laws: forces and derivatives.
+    let w = p.weight;
     let slip = rel + rate * p.normal;
     let slip_speed = slip.norm();
     let (tangential, friction) = match &pair.friction {
@@ -688,14 +702,14 @@ fn evaluate_point_full(
         ContactEval {
             point: *p,
             depth_rate: rate,
-            normal_force: fnormal,
-            tangential_force: tangential,
+            normal_force: w * fnormal,
+            tangential_force: w * tangential,
             slip_speed,
         },
         PointDerivatives {
-            d_depth: normal.d_depth,
-            d_rate: normal.d_rate,
-            friction,
+            d_depth: w * normal.d_depth,
+            d_rate: w * normal.d_rate,
+            friction: w * friction,
         },
     )
 }
@@ -878,7 +892,7 @@ fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives, s: f64) -> M
     let n = e.point.normal;
     let mut g = d.friction * (Mat3::identity() - n * n.transpose());
     let normal = d.d_rate + s * d.d_depth;
-    if e.normal_force > 0.0 && normal != 0.0 {
+    if e.normal_force != 0.0 && normal != 0.0 {
         let along = n + e.tangential_force / e.normal_force;
         g -= normal * along * n.transpose();
     }

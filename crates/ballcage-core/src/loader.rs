@@ -11,15 +11,14 @@
 //! Loading validates, expands and assembles once: a [`Document`] holds the
 //! assembled model, and every simulation of it starts from a copy.
 
-use std::collections::HashMap;
-
 use crate::assembly::{assemble, assemble_validated};
 use crate::drillpipe::{self, DrillPipeSpec, Layout, PipeTables};
 use crate::error::SceneError;
 use crate::model::{Model, State};
 use crate::record::{Observer, TableDef, table_def};
 use crate::scene::{
-    FieldUnits, Scene, TableKind, apply_override, deserialize_with_path, lookup, merge, parse_toml,
+    FieldDoc, FieldInfo, FieldUnits, Scene, TableKind, annotate, apply_override, describe,
+    deserialize_with_path, lookup, merge, parse_toml,
 };
 use crate::sim::Simulation;
 
@@ -215,10 +214,44 @@ impl Document {
 
     /// The document as [`Self::to_toml`] writes it, with the unit of every
     /// number as a comment at the end of its line (`pitch = 0.2  # m`; a
-    /// law's fields in its own `units`, e.g. `# N/mm^2.2`); see
-    /// [`field_unit`]. The text parses to the same values.
+    /// law's fields in its own `units`, e.g. `# N/mm^2.2`), from the
+    /// table of its kind's fields ([`Self::field`]). The text parses to the
+    /// same values.
     pub fn to_toml_with_units(&self) -> String {
-        with_units(&self.to_toml(), &self.source_value())
+        annotate(&self.to_toml(), self.field_docs(), &self.source_value())
+    }
+
+    /// The unit and meaning of every field of the document's kind
+    /// ([`Scene::FIELDS`], [`DrillPipeSpec::FIELDS`]).
+    pub fn field_docs(&self) -> &'static [FieldDoc] {
+        match self.source {
+            Source::Generic => Scene::FIELDS,
+            Source::DrillPipe { .. } => DrillPipeSpec::FIELDS,
+        }
+    }
+
+    /// The unit and meaning of the field at a dotted key (`pipe.pitch`,
+    /// `bodies[1].mass` or `bodies.1.mass`); a contact law's field answers
+    /// in the law's own `units`. An error names a key the document does not
+    /// have.
+    pub fn field(&self, key: &str) -> Result<FieldInfo, SceneError> {
+        describe(self.field_docs(), &self.source_value(), key)
+    }
+
+    /// The factor that turns a value of the contact-law field at `key`,
+    /// written in `from` units, into the units the document writes it in
+    /// ([`crate::scene::scale_from`]); an error names a key that is not a
+    /// number of a contact law.
+    pub fn scale_from(&self, key: &str, from: FieldUnits) -> Result<f64, SceneError> {
+        let root = self.source_value();
+        lookup(&root, key)?;
+        let (law_key, field) = key.rsplit_once('.').unwrap_or(("", key));
+        lookup(&root, law_key)
+            .ok()
+            .and_then(toml::Value::as_table)
+            .filter(|t| t.contains_key("law"))
+            .and_then(|law| crate::scene::scale_from(field, law, from))
+            .ok_or_else(|| SceneError::new(key, "", "is not a number of a contact law"))
     }
 
     /// The resolved value at a dotted key (the syntax of overrides); the
@@ -287,181 +320,6 @@ pub fn tables() -> Vec<&'static TableDef> {
 /// The table named `name`, of any kind.
 pub fn table(name: &str) -> Option<&'static TableDef> {
     tables().into_iter().find(|t| t.name == name)
-}
-
-/// `text`, TOML as [`Document::to_toml`] writes it (table headers and
-/// `key = value` lines at the start of a line, arrays over several lines),
-/// with `  # unit` after each line that sets a number or an array of
-/// numbers whose unit [`field_unit`] knows; `root` is the parsed document.
-fn with_units(text: &str, root: &toml::Value) -> String {
-    let mut section: Option<&toml::Table> = root.as_table();
-    let mut section_name = String::new();
-    // Elements seen so far of each array of tables (`[[bodies]]`), by its dotted name.
-    let mut seen: HashMap<String, usize> = HashMap::new();
-    let mut out = String::with_capacity(text.len() + text.len() / 4);
-    for line in text.lines() {
-        out.push_str(line);
-        if let Some(header) = line.strip_prefix('[') {
-            section_name = header.trim_matches(|c| c == '[' || c == ']').to_string();
-            if header.starts_with('[') {
-                *seen.entry(section_name.clone()).or_default() += 1;
-            }
-            section = table_at(root, &section_name, &seen);
-        } else if let Some((key, _)) = line.split_once(" = ")
-            && !line.starts_with(' ')
-            && let Some(table) = section
-            && table.get(key).is_some_and(is_numeric)
-            && let Some(unit) = field_unit(&section_name, key, table)
-        {
-            out.push_str("  # ");
-            out.push_str(&unit);
-        }
-        out.push('\n');
-    }
-    out
-}
-
-/// The table at the dotted header `name` of `root`; in an array of tables,
-/// the element `seen` counts up to (its last one so far).
-fn table_at<'a>(
-    root: &'a toml::Value,
-    name: &str,
-    seen: &HashMap<String, usize>,
-) -> Option<&'a toml::Table> {
-    let mut v = root;
-    let mut prefix = String::new();
-    for seg in name.split('.').filter(|s| !s.is_empty()) {
-        if !prefix.is_empty() {
-            prefix.push('.');
-        }
-        prefix.push_str(seg);
-        v = v.get(seg)?;
-        if let toml::Value::Array(items) = v {
-            v = items.get(seen.get(&prefix)?.checked_sub(1)?)?;
-        }
-    }
-    v.as_table()
-}
-
-/// A number, or a non-empty array of numbers.
-fn is_numeric(v: &toml::Value) -> bool {
-    match v {
-        toml::Value::Integer(_) | toml::Value::Float(_) => true,
-        toml::Value::Array(a) => !a.is_empty() && a.iter().all(is_numeric),
-        _ => false,
-    }
-}
-
-/// The unit of the number `key` in the table `table` at the dotted
-/// `section` of a scene document of any kind (`"-"` for a pure number),
-/// or `None` when it is not known. Scene fields are SI (the drill pipe's
-/// `_deg` and `_rpm` fields say their unit in their name); a contact law's
-/// fields are in its `units` ([`FieldUnits`]), its stiffness in N/m^n (or
-/// N/mm^n) for its exponent n.
-pub fn field_unit(section: &str, key: &str, table: &toml::Table) -> Option<String> {
-    if let Some(law) = table.get("law").and_then(toml::Value::as_str) {
-        return law_field_unit(law, key, table);
-    }
-    let exact = match (section.rsplit('.').next().unwrap_or(""), key) {
-        ("world", "gravity") => Some("m/s²"),
-        ("newton", _) | ("divergence", "penetration_fraction" | "energy_growth") => Some("-"),
-        ("record", "summary_window") => Some("s"),
-        ("record", "max_bytes") => Some("B"),
-        _ => None,
-    };
-    exact.or_else(|| named_unit(key)).map(str::to_string)
-}
-
-/// The unit a field's name implies (see [`field_unit`]).
-fn named_unit(key: &str) -> Option<&'static str> {
-    const BY_NAME: &[(&[&str], &str)] = &[
-        (
-            &["duration", "dt", "output_interval", "ramp", "spin_ramp"],
-            "s",
-        ),
-        (
-            &[
-                "joints",
-                "tube_contact_points",
-                "points",
-                "threads",
-                "max_steps",
-            ],
-            "-",
-        ),
-        (&["twist_stiffness", "stop_stiffness"], "N·m/rad"),
-        (&["twist_damping"], "N·m·s/rad"),
-        (&["stiffness"], "N/m"),
-        (&["damping"], "N·s/m"),
-        (&["resisting_moment", "magnitude"], "N·m"),
-        (&["velocity"], "m/s"),
-        (&["angular_velocity", "spin_speed"], "rad/s"),
-        (&["density"], "kg/m³"),
-        (&["youngs_modulus", "hardness", "allowable_pressure"], "Pa"),
-        (
-            &["poisson_ratio", "tube_coefficient", "internal_coefficient"],
-            "-",
-        ),
-        (&["orientation", "normal", "axis", "spin_axis"], "-"),
-        (
-            &["position", "pitch", "max_penetration", "half_extents"],
-            "m",
-        ),
-    ];
-    const BY_SUFFIX: &[(&str, &str)] = &[
-        ("_deg", "deg"),
-        ("_rpm", "rpm"),
-        ("mass", "kg"),
-        ("inertia", "kg·m²"),
-        ("radius", "m"),
-        ("diameter", "m"),
-        ("length", "m"),
-        ("width", "m"),
-        ("offset", "m"),
-        ("clearance", "m"),
-    ];
-    BY_NAME
-        .iter()
-        .find(|(names, _)| names.contains(&key))
-        .map(|(_, unit)| *unit)
-        .or_else(|| {
-            BY_SUFFIX
-                .iter()
-                .find(|(suffix, _)| key.ends_with(suffix))
-                .map(|(_, unit)| *unit)
-        })
-}
-
-/// The unit of field `key` of a contact law table `table` whose `law` is `law`.
-fn law_field_unit(law: &str, key: &str, table: &toml::Table) -> Option<String> {
-    let units: FieldUnits = table
-        .get("units")
-        .and_then(|u| u.clone().try_into().ok())
-        .unwrap_or_default();
-    let length = match units {
-        FieldUnits::Si => "m",
-        FieldUnits::NMmS => "mm",
-    };
-    let unit = match key {
-        "stiffness" => {
-            let n = match (law, table.get("exponent")) {
-                (_, Some(n)) => n.as_float().or_else(|| n.as_integer().map(|i| i as f64))?,
-                ("hertz", None) => 1.5,
-                _ => 1.0,
-            };
-            if n == 1.0 {
-                format!("N/{length}")
-            } else {
-                format!("N/{length}^{n}")
-            }
-        }
-        "damping" => format!("N·s/{length}"),
-        "depth_max" => length.to_string(),
-        "v_static" | "v_dynamic" | "v_ref" | "min_approach_speed" => format!("{length}/s"),
-        "exponent" | "restitution" | "mu" | "mu_static" | "mu_dynamic" => "-".to_string(),
-        _ => return None,
-    };
-    Some(unit)
 }
 
 /// The embedded default document: the paper's drill pipe.
@@ -550,15 +408,28 @@ mod tests {
         }
     }
 
+    /// A ball on the ground: a generic scene with two bodies and a Hertz pair.
+    const BALL_ON_GROUND: &str = r#"
+        [simulation]
+        duration = 0.1
+        dt = 1e-4
+        output_interval = 1e-3
+        [[bodies]]
+        name = "ground"
+        motion = "fixed"
+        shape = { type = "half-space", normal = [0.0, 0.0, 1.0] }
+        [[bodies]]
+        name = "ball"
+        mass = 1.0
+        shape = { type = "ball", radius = 0.05 }
+        [[contacts]]
+        bodies = ["ground", "ball"]
+        normal = { law = "hertz", stiffness = 1e8 }
+    "#;
+
     #[test]
     fn each_element_of_an_array_of_tables_gets_its_own_units() {
-        let text = "[simulation]\nduration = 0.1\ndt = 1e-4\noutput_interval = 1e-3\n\
-                    [[bodies]]\nname = \"ground\"\nmotion = \"fixed\"\n\
-                    shape = { type = \"half-space\", normal = [0.0, 0.0, 1.0] }\n\
-                    [[bodies]]\nname = \"ball\"\nmass = 1.0\nshape = { type = \"ball\", radius = 0.05 }\n\
-                    [[contacts]]\nbodies = [\"ground\", \"ball\"]\n\
-                    normal = { law = \"hertz\", stiffness = 1e8 }\n";
-        let annotated = Document::from_toml_str(text, &[])
+        let annotated = Document::from_toml_str(BALL_ON_GROUND, &[])
             .unwrap()
             .to_toml_with_units();
         for expected in [
@@ -573,20 +444,163 @@ mod tests {
 
     #[test]
     fn law_units_follow_the_law_and_its_field_units() {
-        let law = |text: &str| text.parse::<toml::Table>().unwrap();
-        let si = law("law = \"hertz\"\nstiffness = 1e8");
+        let again = r#"
+            [[contacts]]
+            name = "again"
+            bodies = ["ground", "ball"]
+            normal = { law = "linear", stiffness = 1e5, damping = 1, units = "N-mm-s" }
+        "#;
+        let text = format!("{BALL_ON_GROUND}{again}");
+        let doc = Document::from_toml_str(&text, &[]).unwrap();
+        let unit = |key: &str| doc.field(key).map(|f| f.unit);
+        assert_eq!(unit("contacts[0].normal.stiffness").unwrap(), "N/m^1.5");
+        assert_eq!(unit("contacts.1.normal.stiffness").unwrap(), "N/mm");
+        assert_eq!(unit("contacts[1].normal.damping").unwrap(), "N·s/mm");
+        assert_eq!(unit("contacts[1].normal.units").unwrap(), "");
+        assert_eq!(unit("world.gravity").unwrap(), "m/s²");
+        assert_eq!(unit("world.gravity[2]").unwrap(), "m/s²");
+        assert_eq!(unit("bodies[1].mass").unwrap(), "kg");
+        assert_eq!(unit("bodies.1.shape.radius").unwrap(), "m");
+        assert_eq!(unit("bodies[0].name").unwrap(), "");
         assert_eq!(
-            field_unit("contacts.normal", "stiffness", &si).unwrap(),
-            "N/m^1.5"
+            doc.field("bodies[1].mass").unwrap().meaning,
+            "mass; alternative to density"
         );
-        let lin = law("law = \"linear\"\nstiffness = 1e5\ndamping = 1\nunits = \"N-mm-s\"");
-        assert_eq!(field_unit("x", "stiffness", &lin).unwrap(), "N/mm");
-        assert_eq!(field_unit("x", "damping", &lin).unwrap(), "N·s/mm");
-        let none = toml::Table::new();
-        assert_eq!(field_unit("world", "gravity", &none).unwrap(), "m/s²");
-        assert_eq!(field_unit("bodies", "mass", &none).unwrap(), "kg");
-        assert_eq!(field_unit("pipe", "neck_radius", &none).unwrap(), "m");
-        assert_eq!(field_unit("bodies", "whatever", &none), None);
+        for missing in ["bodies[1].whatever", "bodies[7].mass", "nope", ""] {
+            assert!(doc.field(missing).is_err(), "{missing}");
+        }
+        let pipe = Document::from_toml_str("kind = \"drill-pipe\"", &[]).unwrap();
+        assert_eq!(pipe.field("pipe.neck_radius").unwrap().unit, "m");
+        assert_eq!(
+            pipe.field("materials.tube.normal.stiffness").unwrap().unit,
+            "N/mm^2.2"
+        );
+        let e = pipe.field("pipe.neck_radiu").unwrap_err();
+        assert_eq!(e.path, "pipe.neck_radiu");
+    }
+
+    #[test]
+    fn a_law_value_converts_from_other_field_units_to_the_laws_own() {
+        let key = "materials.internal.normal";
+        let si = [format!("{key}.units=\"SI\"")];
+        let paper = Document::from_toml_str("kind = \"drill-pipe\"", &[]).unwrap();
+        let si = Document::from_toml_str("kind = \"drill-pipe\"", &si).unwrap();
+        let scale = |doc: &Document, field: &str, from| {
+            doc.scale_from(&format!("{key}.{field}"), from).unwrap()
+        };
+        assert_eq!(scale(&paper, "stiffness", FieldUnits::NMmS), 1.0);
+        assert_eq!(scale(&si, "stiffness", FieldUnits::NMmS), 1000f64.powf(2.2));
+        assert_eq!(scale(&si, "damping", FieldUnits::NMmS), 1000.0);
+        assert_eq!(scale(&si, "depth_max", FieldUnits::NMmS), 1e-3);
+        assert_eq!(scale(&paper, "depth_max", FieldUnits::Si), 1000.0);
+        assert_eq!(scale(&si, "exponent", FieldUnits::NMmS), 1.0);
+        assert!(si.scale_from("pipe.pitch", FieldUnits::NMmS).is_err());
+        assert!(
+            si.scale_from(&format!("{key}.law"), FieldUnits::NMmS)
+                .is_err()
+        );
+        assert!(
+            si.scale_from(&format!("{key}.nope"), FieldUnits::NMmS)
+                .is_err()
+        );
+    }
+
+    /// The documents `scene show` prints in the tests: the default drill
+    /// pipe under either hinge model and every scene of examples/scenes/.
+    fn shown_documents() -> Vec<(String, Document)> {
+        let mut docs: Vec<(String, Document)> = ["ball-keys", "ideal-cv"]
+            .iter()
+            .map(|hinge| {
+                let overrides = [format!("pipe.hinge=\"{hinge}\"")];
+                let doc = Document::from_toml_str("kind = \"drill-pipe\"", &overrides).unwrap();
+                (format!("drill pipe, {hinge}"), doc)
+            })
+            .collect();
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let text = std::fs::read_to_string(&path).unwrap();
+                docs.push((
+                    path.display().to_string(),
+                    Document::from_toml_str(&text, &[]).unwrap(),
+                ));
+            }
+        }
+        assert!(docs.len() >= 4, "{} documents", docs.len());
+        docs
+    }
+
+    /// Every number `scene show` prints has an entry in its kind's table of
+    /// fields (a new field without one fails here), every other key has a
+    /// meaning, and every numeric line of the printed text carries its unit.
+    #[test]
+    fn every_number_scene_show_prints_has_a_documented_unit() {
+        for (name, doc) in shown_documents() {
+            let root = doc.source_value();
+            for key in crate::scene::numeric_keys(&root, "") {
+                let field = doc
+                    .field(&key)
+                    .unwrap_or_else(|e| panic!("{name}: {key}: {e}"));
+                assert!(!field.unit.is_empty(), "{name}: {key} has no unit");
+                assert!(!field.meaning.is_empty(), "{name}: {key} has no meaning");
+            }
+            let text = doc.to_toml_with_units();
+            let lines: Vec<&str> = text.lines().collect();
+            let number = |v: &str| v.starts_with(|c: char| c.is_ascii_digit() || c == '-');
+            for (i, line) in lines.iter().enumerate() {
+                let Some((_, value)) = line.split_once(" = ").filter(|_| !line.starts_with(' '))
+                else {
+                    continue;
+                };
+                let value = value.split("  # ").next().unwrap_or("");
+                let next = lines.get(i + 1).map_or("", |l| l.trim());
+                if number(value) || (value == "[" && number(next)) {
+                    assert!(line.contains("  # "), "{name}: no unit on `{line}`");
+                }
+            }
+        }
+    }
+
+    /// Each table of fields names a key once, with a meaning and a unit
+    /// only where it holds numbers; every key of a shown document is in it.
+    #[test]
+    fn the_tables_of_fields_are_complete_and_unique() {
+        for docs in [Scene::FIELDS, DrillPipeSpec::FIELDS] {
+            let flat = crate::scene::flatten(docs);
+            for (i, (key, doc)) in flat.iter().enumerate() {
+                assert!(flat[..i].iter().all(|(k, _)| k != key), "{key} twice");
+                assert!(!doc.meaning.is_empty(), "{key} has no meaning");
+            }
+        }
+        fn keys(v: &toml::Value, path: &str, out: &mut Vec<String>) {
+            let join = |k: &str| {
+                if path.is_empty() {
+                    k.to_string()
+                } else {
+                    format!("{path}.{k}")
+                }
+            };
+            match v {
+                toml::Value::Table(t) => t.iter().for_each(|(k, x)| {
+                    out.push(join(k));
+                    keys(x, &join(k), out);
+                }),
+                toml::Value::Array(a) => a
+                    .iter()
+                    .enumerate()
+                    .for_each(|(i, x)| keys(x, &join(&i.to_string()), out)),
+                _ => {}
+            }
+        }
+        for (name, doc) in shown_documents() {
+            let mut all = Vec::new();
+            keys(&doc.source_value(), "", &mut all);
+            for key in all {
+                doc.field(&key)
+                    .unwrap_or_else(|e| panic!("{name}: {key}: {e}"));
+            }
+        }
     }
 
     #[test]

@@ -14,7 +14,9 @@ pub enum Motion {
     Dynamic,
     /// Prescribed spin about a world axis through the centre of mass.
     KinematicSpin(SpinProfile),
-    /// One degree of freedom: spin about a world axis through the fixed centre of mass.
+    /// One degree of freedom: spin about a world axis through the fixed
+    /// centre of mass; with `slides`, two: the centre of mass also slides
+    /// along that axis (a cylindrical joint to the ground).
     Spin {
         /// Unit spin axis, world frame.
         axis: Vec3,
@@ -22,6 +24,8 @@ pub enum Motion {
         axis_body: Vec3,
         /// Moment of inertia about the axis [kg·m²].
         inertia: f64,
+        /// Whether the centre of mass is free to slide along `axis`.
+        slides: bool,
     },
 }
 
@@ -142,6 +146,31 @@ impl TorqueLoad {
     }
 }
 
+/// A force `magnitude·axis·STEP(t, 0, 0, ramp, 1)` at a body's centre of mass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForceLoad {
+    /// Body index.
+    pub body: usize,
+    /// Unit direction, world frame.
+    pub axis: Vec3,
+    /// Signed magnitude along `axis` [N].
+    pub magnitude: f64,
+    /// Ramp [s].
+    pub ramp: f64,
+}
+
+impl ForceLoad {
+    /// Force vector at time t [N].
+    pub fn force(&self, t: f64) -> Vec3 {
+        let s = if self.ramp <= 0.0 {
+            1.0
+        } else {
+            step(t, 0.0, 0.0, self.ramp, 1.0).0
+        };
+        self.axis * (self.magnitude * s)
+    }
+}
+
 /// An ideal constant-velocity joint between bodies a and b.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Joint {
@@ -221,6 +250,8 @@ pub struct Model {
     pub pairs: Vec<ContactPair>,
     /// Applied torques.
     pub torques: Vec<TorqueLoad>,
+    /// Applied forces (at the centres of mass).
+    pub forces: Vec<ForceLoad>,
     /// Penalty joints.
     pub joints: Vec<Joint>,
     /// Gravity [m/s²], world frame.

@@ -322,11 +322,13 @@ impl Simulation {
         if let Some(e) = &self.failed {
             metadata.push(("ballcage.error".to_string(), e.to_string()));
         }
+        let part_labels = self.recorder.part_labels();
         let tables = self.recorder.finish(&self.model, self.state.t);
         Recording {
             tables,
             body_names: self.model.bodies.iter().map(|b| b.name.clone()).collect(),
             pair_names: self.model.pairs.iter().map(|p| p.name.clone()).collect(),
+            part_labels,
             metadata,
         }
     }
@@ -498,13 +500,19 @@ impl Simulation {
         ))
     }
 
-    /// Adds the work of the applied torques and of the prescribed bodies
+    /// Adds the work of the applied torques and forces and of the prescribed bodies
     /// (minus what the joints and contacts do on them) over the step, from
     /// the last force evaluation and the new velocities.
     fn add_input_work(&mut self, h: f64) {
         let (model, state, b) = (&self.model, &self.state, &mut self.balance);
         for l in &model.torques {
             let p = l.torque(state.t).dot(&state.omega_world(l.body));
+            b.work_load += p * h;
+            b.work_in += p * h;
+            b.work_abs += p.abs() * h;
+        }
+        for l in &model.forces {
+            let p = l.force(state.t).dot(&state.vel[l.body]);
             b.work_load += p * h;
             b.work_in += p * h;
             b.work_abs += p.abs() * h;

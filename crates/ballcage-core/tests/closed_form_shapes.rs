@@ -9,7 +9,9 @@
 //! Conventions: δ > 0 into the wall; the normal points from the container
 //! (body a) toward the body it holds (b).
 
-use ballcage_core::geometry::{ContactPoint, PairGeometry, Shape, TubePath, TubeSegment};
+use ballcage_core::geometry::{
+    ContactPoint, LineContact, LineLaw, PairGeometry, Shape, TubePath, TubeSegment,
+};
 use ballcage_core::math::{Quat, Vec3};
 use ballcage_shapes::{GrooveFlank, ShapeDispatcher, SphericalCavity, TubeInterior, WindowSlot};
 use parry3d_f64::math::{Pose, Rotation, Vector};
@@ -353,16 +355,19 @@ fn a_cylinder_across_the_bend_touches_off_plane_at_both_rims() {
             radius: r,
             half_length: h,
         };
-        let got = ballcage(
-            PairGeometry::CylinderTube { points: 5 },
-            &Shape::Tube(t.clone()),
-            &pa,
-            &cyl,
-            &(centre, q),
-        );
-        assert_eq!(got.len(), 2, "ballcage at {deg}°");
-        for (g, n) in got.iter().zip(&rims) {
-            assert_world(g, delta, n, &format!("ballcage, rim at {deg}°"));
+        // Both line laws: two separate patches, one point law at each rim.
+        for law in [LineLaw::LevelSets, LineLaw::Patches] {
+            let got = ballcage(
+                PairGeometry::CylinderTube(LineContact { points: 5, law }),
+                &Shape::Tube(t.clone()),
+                &pa,
+                &cyl,
+                &(centre, q),
+            );
+            assert_eq!(got.len(), 2, "ballcage at {deg}°, {law:?}");
+            for (g, n) in got.iter().zip(&rims) {
+                assert_world(g, delta, n, &format!("ballcage, rim at {deg}°, {law:?}"));
+            }
         }
         // parry: its cylinder's axis is its local y, already along the tube's y.
         let pb = glam_pose(&(centre, pa.1));

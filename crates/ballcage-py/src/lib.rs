@@ -9,7 +9,7 @@ use std::sync::{Arc, Mutex};
 
 use ballcage_core::drillpipe::sizing;
 use ballcage_core::loader::{self, Document, Kind};
-use ballcage_core::scene::{IntegratorKind, whole_multiple as core_whole_multiple};
+use ballcage_core::scene::{FieldUnits, IntegratorKind, whole_multiple as core_whole_multiple};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -165,6 +165,11 @@ fn internal_err(py: Python<'_>, message: String) -> PyErr {
     raise(py, |t| &t.internal, message)
 }
 
+/// An `InputError` for a key `Scene.<method>` cannot answer for.
+fn unknown_key(py: Python<'_>, method: &str, key: &str, e: ballcage_core::SceneError) -> PyErr {
+    input_err(py, format!("Scene.{method}({key:?}): {e}"))
+}
+
 /// A validated, assembled scene document of any kind.
 #[pyclass(module = "ballcage._native", frozen)]
 struct Scene {
@@ -284,6 +289,49 @@ impl Scene {
         self.inner.kind().name()
     }
 
+    /// Names of the bodies the integrator moves (motion `dynamic` or
+    /// `spin`: `BodySpec::is_integrated`), in body order; for a drill pipe,
+    /// those of its expansion.
+    #[getter]
+    fn integrated_bodies(&self) -> Vec<String> {
+        let bodies = &self.inner.scene().bodies;
+        bodies
+            .iter()
+            .filter(|b| b.is_integrated())
+            .map(|b| b.name.clone())
+            .collect()
+    }
+
+    /// The unit of the field at a dotted key, as `scene show` prints it.
+    fn unit(&self, py: Python<'_>, key: &str) -> PyResult<String> {
+        let field = self.inner.field(key);
+        Ok(field.map_err(|e| unknown_key(py, "unit", key, e))?.unit)
+    }
+
+    /// One line on what the field at a dotted key is.
+    fn meaning(&self, py: Python<'_>, key: &str) -> PyResult<&'static str> {
+        let field = self.inner.field(key);
+        Ok(field
+            .map_err(|e| unknown_key(py, "meaning", key, e))?
+            .meaning)
+    }
+
+    /// The factor that turns a value of the contact-law field at `key`,
+    /// written in `units` ("SI" or "N-mm-s"), into the law's own units.
+    fn scale_from(&self, py: Python<'_>, key: &str, units: &str) -> PyResult<f64> {
+        let from: FieldUnits = toml::Value::String(units.to_string())
+            .try_into()
+            .map_err(|_| {
+                input_err(
+                    py,
+                    format!("units = {units:?}: must be \"SI\" or \"N-mm-s\""),
+                )
+            })?;
+        self.inner
+            .scale_from(key, from)
+            .map_err(|e| unknown_key(py, "scale_from", key, e))
+    }
+
     /// The resolved value at a dotted key of the scene document.
     fn value<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
         let v = self.inner.value(key).map_err(|e| scene_err(py, e))?;
@@ -323,14 +371,15 @@ impl Scene {
 
     /// `count` points along the drill pipe's extended tube centreline.
     fn centreline<'py>(&self, py: Python<'py>, count: usize) -> PyResult<Bound<'py, PyDict>> {
-        let (spec, layout) = self.drill_pipe(py, "centreline")?;
+        let layout = self.drill_pipe(py, "centreline")?.1;
         if count < 2 {
             return Err(input_err(
                 py,
                 format!("count = {count}: must be at least 2 points"),
             ));
         }
-        let path = spec.extended_centreline();
+        // the path the load built once, the one the chain was placed on
+        let path = &layout.centreline;
         let (mut point, mut tangent, mut outward, mut s) = (vec![], vec![], vec![], vec![]);
         for i in 0..count {
             let arc = path.length() * i as f64 / (count - 1) as f64;
@@ -523,20 +572,28 @@ fn whole_multiple(interval: f64, step: f64) -> Option<u64> {
 
 /// Eq. (9): the longest rigid link [m] that fits the bent tube.
 #[pyfunction]
-fn longest_link(curvature_radius: f64, tube_diameter: f64, link_radius: f64) -> f64 {
-    sizing::longest_link(curvature_radius, tube_diameter, link_radius)
+fn longest_link(curvature_radius: f64, tube_inner_diameter: f64, link_outer_diameter: f64) -> f64 {
+    sizing::longest_link(curvature_radius, tube_inner_diameter, link_outer_diameter)
 }
 
 /// Eq. (9) solved for R: the tightest centreline radius [m] a link fits.
 #[pyfunction]
-fn tightest_radius_for_link(length: f64, tube_diameter: f64, link_radius: f64) -> f64 {
-    sizing::tightest_radius_for_link(length, tube_diameter, link_radius)
+fn tightest_radius_for_link(
+    link_length: f64,
+    tube_inner_diameter: f64,
+    link_outer_diameter: f64,
+) -> f64 {
+    sizing::tightest_radius_for_link(link_length, tube_inner_diameter, link_outer_diameter)
 }
 
-/// Eq. (9) solved for r: the largest link radius [m] for a length, or `None`.
+/// Eq. (9) solved for d: the largest link outer diameter [m] for a length, or `None`.
 #[pyfunction]
-fn largest_link_radius(length: f64, curvature_radius: f64, tube_diameter: f64) -> Option<f64> {
-    sizing::largest_link_radius(length, curvature_radius, tube_diameter)
+fn largest_link_diameter(
+    link_length: f64,
+    curvature_radius: f64,
+    tube_inner_diameter: f64,
+) -> Option<f64> {
+    sizing::largest_link_diameter(link_length, curvature_radius, tube_inner_diameter)
 }
 
 /// The tightest radius [m] at which hinges of pitch `pitch` bend `bend_limit` [rad].
@@ -572,7 +629,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(whole_multiple, m)?)?;
     m.add_function(wrap_pyfunction!(longest_link, m)?)?;
     m.add_function(wrap_pyfunction!(tightest_radius_for_link, m)?)?;
-    m.add_function(wrap_pyfunction!(largest_link_radius, m)?)?;
+    m.add_function(wrap_pyfunction!(largest_link_diameter, m)?)?;
     m.add_function(wrap_pyfunction!(tightest_radius_for_bend, m)?)?;
     m.add(
         "TABLE_NAMES",

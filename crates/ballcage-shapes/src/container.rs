@@ -10,9 +10,10 @@
 use parry3d_f64::shape::Shape;
 
 use crate::cavity::SphericalCavity;
+use crate::centreline::Centreline;
 use crate::contact::{Body, LocalContact, Rod};
 use crate::groove::GrooveFlank;
-use crate::line::{Centreline, Ends, line_patches, line_stations};
+use crate::line::{Ends, line_patches, line_stations};
 use crate::slot::WindowSlot;
 use crate::tube::TubeInterior;
 

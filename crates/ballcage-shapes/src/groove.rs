@@ -12,9 +12,8 @@
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 
+use crate::centreline::{Centreline, CentrelinePoint};
 use crate::contact::{LocalContact, unit};
-use crate::line::Centreline;
-use crate::tube::CentrelinePoint;
 
 /// The inside of the tube of a torus, in its frame: the solid is everything
 /// farther than `tube_radius` from the core circle.

@@ -65,6 +65,7 @@
 //! `examples/rapier_ball_in_bent_tube.rs` is a whole program.
 
 mod cavity;
+mod centreline;
 mod contact;
 pub mod container;
 mod dispatcher;
@@ -76,10 +77,11 @@ mod slot;
 mod tube;
 
 pub use cavity::SphericalCavity;
+pub use centreline::{Centreline, CentrelinePoint};
 pub use contact::{Body, LocalContact, Rod};
 pub use container::{Container, LineOptions, Reduction, as_container};
 pub use dispatcher::ShapeDispatcher;
 pub use groove::GrooveFlank;
-pub use line::{Centreline, Ends};
+pub use line::Ends;
 pub use slot::WindowSlot;
-pub use tube::{CentrelinePoint, TubeInterior, TubeSegment};
+pub use tube::{TubeInterior, TubeSegment};

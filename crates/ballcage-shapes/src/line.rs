@@ -14,28 +14,24 @@
 //! is exact, and a contact lying wholly between two samples (a straight link
 //! against the convex inner wall of a bend) is not missed.
 //!
-//! Two reductions of the same walk along the axis:
+//! Three reductions of the depth along the axis:
+//! - [`line_extrema`]: every depth maximum (ends included) and every
+//!   interior depth minimum, found exactly, for the level-set law whose
+//!   energy is Σ Φ(δ_max) − Σ Φ(δ_min): continuous in the rod's pose, the
+//!   gradient of that energy, independent of the sampling once each
+//!   extremum has a bracket of its own (ballcage's default);
 //! - [`line_patches`]: one contact per patch (a run of samples in contact,
 //!   or such a hidden maximum) at its largest penetration, acting at the
-//!   patch's centre of pressure: MSC Adams' convention, which ballcage's
-//!   penalty law follows, so the force does not depend on the sampling;
+//!   patch's centre of pressure: MSC Adams' convention (the force does not
+//!   depend on the sampling, but it jumps when patches merge or split);
 //! - [`line_stations`]: every sample in contact and every hidden maximum,
 //!   each with its own exact depth and normal: what a rigid-contact solver
 //!   (rapier) wants for a line contact.
 
 use parry3d_f64::math::Vector;
 
+use crate::centreline::Centreline;
 use crate::contact::{LocalContact, Rod, unit};
-use crate::tube::CentrelinePoint;
-
-/// A lumen around a centreline: the wall is `wall_radius` from it.
-pub trait Centreline {
-    /// Nearest centreline point to `q`, or `None` where there is no wall
-    /// (past an open end, or on a torus's axis).
-    fn nearest(&self, q: Vector) -> Option<CentrelinePoint>;
-    /// Distance from the centreline to the wall [m].
-    fn wall_radius(&self) -> f64;
-}
 
 /// The ends of a rod.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -54,6 +50,7 @@ struct RodInLumen<'a, L: ?Sized> {
 }
 
 /// The deepest surface point of one axial station.
+#[derive(Clone, Copy)]
 struct Station {
     /// Midpoint between the surfaces [m].
     point: Vector,
@@ -132,7 +129,24 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// `a` and `gb` ≤ 0 at `b`: the Illinois variant of regula falsi, which
     /// converges superlinearly on this smooth root, to 1e-12 of the
     /// positions. `None` if a station on the way does not exist.
-    fn deepest(&self, (mut a, mut ga): (f64, f64), (mut b, mut gb): (f64, f64)) -> Option<f64> {
+    fn deepest(&self, a: (f64, f64), b: (f64, f64)) -> Option<f64> {
+        self.stationary(a, b, 1.0)
+    }
+
+    /// The axial position in `[a, b]` where u·â changes sign: with
+    /// `sign` = 1 from positive at `a` to non-positive at `b` (a depth
+    /// maximum, see [`Self::deepest`]); with `sign` = −1 from non-positive
+    /// to positive (a depth minimum). The growths given are multiplied by
+    /// `sign`, so `ga` > 0 ≥ `gb` either way.
+    fn stationary(
+        &self,
+        (mut a, mut ga): (f64, f64),
+        (mut b, mut gb): (f64, f64),
+        sign: f64,
+    ) -> Option<f64> {
+        if ga == 0.0 {
+            return Some(a);
+        }
         let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
         // Which end moved last: +1 for a, −1 for b.
         let mut side = 0;
@@ -142,7 +156,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             }
             let x = (a * gb - b * ga) / (gb - ga);
             let x = if x > a && x < b { x } else { 0.5 * (a + b) };
-            let gx = self.station(x)?.growth;
+            let gx = sign * self.station(x)?.growth;
             if gx > 0.0 {
                 (a, ga) = (x, gx);
                 if side == 1 {
@@ -379,6 +393,102 @@ pub fn line_stations<L: Centreline + ?Sized>(
             }
         }
     });
+}
+
+/// Whether a depth extremum of [`line_extrema`] is a maximum or an
+/// interior minimum of the depth along the axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Extremum {
+    /// A local maximum of the depth, at an end or between two samples.
+    Maximum,
+    /// An interior local minimum of the depth (a dip between two maxima).
+    Minimum,
+}
+
+impl Extremum {
+    /// +1 for a maximum, −1 for a minimum: the sign with which its point
+    /// law enters the level-set law (see [`line_extrema`]).
+    pub fn weight(self) -> f64 {
+        match self {
+            Self::Maximum => 1.0,
+            Self::Minimum => -1.0,
+        }
+    }
+}
+
+/// The exact extrema of the depth δ(s) along `rod` inside `lumen` that are
+/// deeper than `threshold` [m]: every local maximum (the ends included) and
+/// every interior local minimum, each with its own exact depth, point and
+/// normal, in the lumen's frame, in axial order.
+///
+/// This is what the level-set line law needs: the number of connected
+/// pieces of the contact deeper than h is N(h) = #{maxima > h} −
+/// #{interior minima > h} (passing a maximum downward opens a piece,
+/// passing an interior minimum joins two), so the energy
+/// E = ∫₀^∞ (dΦ/dh)·N(h) dh of a point law with energy Φ(δ) is
+/// Σ_maxima Φ(δ_i) − Σ_minima Φ(δ_m), and its forces are the point law at
+/// each maximum minus the point law at each minimum. E and its gradient are
+/// continuous when pieces appear, merge, split or vanish: a minimum rising
+/// through h = 0 enters with Φ(0) = 0, and a maximum and minimum that meet
+/// annihilate with equal and opposite terms.
+///
+/// The `samples` (≥ 2, ends included) only bracket the extrema: each sign
+/// change of u·â between two samples is refined by regula falsi to 1e-12 of
+/// the positions. A maximum and a minimum hidden between the same two
+/// samples are not seen; such a pair is shallow when it forms (its terms
+/// cancel), which is why the answer converges in the sample count.
+/// `feature`: an end maximum is sample 0 or `samples` − 1, an interior
+/// maximum between samples k and k + 1 is k, an interior minimum there is
+/// `samples` + k: unique and stable, below 2·`samples`.
+pub fn line_extrema<L: Centreline + ?Sized>(
+    lumen: &L,
+    rod: &Rod,
+    ends: Ends,
+    samples: u32,
+    threshold: f64,
+    emit: &mut impl FnMut(LocalContact, Extremum),
+) {
+    let link = RodInLumen {
+        lumen,
+        rod: *rod,
+        ends,
+    };
+    let n = samples.max(2) as usize;
+    let h = rod.half_length;
+    let s = |k: usize| -h + 2.0 * h * k as f64 / (n - 1) as f64;
+    let mut put = |st: Station, feature: usize, kind: Extremum| {
+        if st.depth > threshold {
+            emit(st.contact(feature), kind);
+        }
+    };
+    let mut here = link.station(s(0));
+    if let Some(st) = here.as_ref().filter(|st| st.growth <= 0.0) {
+        put(*st, 0, Extremum::Maximum);
+    }
+    for k in 0..n - 1 {
+        let next = link.station(s(k + 1));
+        if let (Some(a), Some(b)) = (&here, &next) {
+            let rising = (a.growth > 0.0, b.growth > 0.0);
+            let found = match rising {
+                (true, false) => link
+                    .stationary((s(k), a.growth), (s(k + 1), b.growth), 1.0)
+                    .map(|x| (x, k, Extremum::Maximum)),
+                (false, true) => link
+                    .stationary((s(k), -a.growth), (s(k + 1), -b.growth), -1.0)
+                    .map(|x| (x, n + k, Extremum::Minimum)),
+                _ => None,
+            };
+            if let Some((x, feature, kind)) = found
+                && let Some(st) = link.station(x)
+            {
+                put(st, feature, kind);
+            }
+        }
+        here = next;
+    }
+    if let Some(st) = here.filter(|st| st.growth > 0.0) {
+        put(st, n - 1, Extremum::Maximum);
+    }
 }
 
 #[cfg(test)]

@@ -17,9 +17,9 @@ use parry3d_f64::query::{PointProjection, PointQuery, Ray, RayCast, RayIntersect
 use parry3d_f64::shape::FeatureId;
 
 use crate::cavity::SphericalCavity;
+use crate::centreline::Centreline;
 use crate::contact::{perpendicular, unit};
 use crate::groove::GrooveFlank;
-use crate::line::Centreline;
 use crate::slot::WindowSlot;
 use crate::tube::TubeInterior;
 
@@ -100,7 +100,7 @@ impl PointQuery for GrooveFlank {
         // On the race's axis every core point is as near: take one.
         let c = Centreline::nearest(self, pt).unwrap_or_else(|| {
             let dir = perpendicular(self.axis);
-            crate::tube::CentrelinePoint {
+            crate::centreline::CentrelinePoint {
                 point: self.centre + self.core_radius * dir,
                 tangent: self.axis.cross(dir),
             }

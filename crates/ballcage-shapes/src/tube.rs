@@ -9,8 +9,8 @@
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 
+use crate::centreline::{Centreline, CentrelinePoint};
 use crate::contact::{LocalContact, unit};
-use crate::line::Centreline;
 
 /// One piece of a tube centreline as declared: it continues from where the
 /// previous piece ends, along the current direction.
@@ -53,15 +53,6 @@ pub(crate) enum Segment {
         angle: f64,
         end: (f64, f64),
     },
-}
-
-/// The nearest centreline point to a query point.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CentrelinePoint {
-    /// Point on the centreline [m], tube frame.
-    pub point: Vector,
-    /// Unit tangent there.
-    pub tangent: Vector,
 }
 
 /// The inside of a tube: a centreline of straight and arc segments with an

@@ -1,7 +1,8 @@
 """The paper's run: Zhu et al., *Machines* 2023, 11, 357, reproduced and compared.
 
-`run_paper` runs the embedded drill-pipe scene (`ballcage.default_scene`) with
-every table recorded, and writes into one directory:
+`run_paper` runs the embedded drill-pipe scene (`paper_scene`: the default
+scene of `ballcage.scene.default_scene` recording `PAPER_TABLES`), and writes
+into one directory:
 
 - ``<table>.parquet`` and ``scene.toml`` (`Run.write`);
 - the paper's figures as PNG: ``fig09_included_angles``, ``fig10_tube_normal``,
@@ -14,8 +15,10 @@ every table recorded, and writes into one directory:
   paper's value, ours, their ratio and a note on how our definition differs
   and on values the paper itself contradicts (``suspect``); plus the rows of
   `EXTRA_ROWS` the file lacks (``range_of_motion_peak_to_peak_mm``, the
-  definition of Table 3's range of motion that fits the paper, and
-  ``head_cage_normal_peak_n``, which the paper does not report).
+  definition of Table 3's range of motion that fits the paper, the included
+  angles projected on the bend plane, the inclination where the tube force is
+  largest, and ``head_cage_normal_peak_n``, which the paper does not report);
+  ``comparison.md`` also says where our forces are largest beside the paper's.
 
 With ``sweeps=True`` it also runs the paper's §4.2–4.3 as one sweep
 (`section4`: R = 1.0–2.5 m, 60–120 rpm, and the baseline's run-to-run
@@ -26,21 +29,22 @@ spread) into ``sweeps/``, fills the ``sweep_*`` rows, draws Figures 16–17
 `comparison(run)` builds the comparison table from any run of the paper scene,
 so it can be checked on a short run. Everything is computed from the recorded
 tables (``links``, ``hinges``, ``keys``) and the scene's own values
-(`Run.scene`); the definitions are in `DEFINITIONS` and are repeated in each
-row's note.
+(`Run.scene`); the values by `ballcage.measures` (Table 3's phases and
+motion, the peak forces: the same functions as a sweep's summary columns),
+the definitions in `DEFINITIONS`, repeated in each row's note.
 
 Modules, one job each: `running` (the scenes and `run_paper`), `definitions`
-(the reference file and how each quantity is computed), `facts` (scene values
-and Table 3's phases), `motion` (Table 3's most deformed joint and range of
-motion: most frequent link, peak-to-peak excursion), `frames` (per-frame grids
-of the tables), `compare` (the comparison table), `markdown`
-(``comparison.md``), `figures` (the PNGs), `section4`, `section4_figures`
-and `trends` (the §4 sweep; imported on use, as they load the sweep machinery).
+(the reference file and how each quantity is computed), `compare` (the
+comparison table), `places` (where the forces are largest, in words),
+`markdown` (``comparison.md``), `figures` (the PNGs),
+`section4`, `section4_figures` and `trends` (the §4 sweep; imported on use, as
+they load the sweep machinery). Above `ballcage.studies` and `ballcage.view`;
+nothing but the CLI imports it.
 """
 
 from ballcage.paper.compare import COMPARISON_SCHEMA, comparison
 from ballcage.paper.definitions import EXTRA_ROWS, SWEEPS, TUBE_LINKS, reference
-from ballcage.paper.facts import PHASES
+from ballcage.measures.phases import PHASES
 from ballcage.paper.figures import FIGURES, KEY_BODIES, write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.paper.running import PAPER_TABLES, paper_scene, run_paper

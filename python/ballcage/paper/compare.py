@@ -26,9 +26,19 @@ from ballcage.paper.definitions import (
     TUBE_LINKS,
     reference,
 )
-from ballcage.paper.facts import Phase, SceneFacts, phases, scene_facts
-from ballcage.paper.frames import argmax_where, frame_grid, frame_times
-from ballcage.paper.motion import MostFrequent, centre_paths, last_revolution, most_frequent
+from ballcage.measures.phases import SceneFacts, scene_facts
+from ballcage.measures.quantities import (
+    CAGE_PEAKS,
+    KEY_PEAKS,
+    Peak,
+    Table3Motion,
+    column_peaks,
+    race_peak,
+    table3_motion,
+)
+from ballcage.measures.places import peak_place, tube_profile
+from ballcage.measures.shape import BendRanking
+from ballcage.paper.places import distribution_row, key_place_text, link12_text
 from ballcage.run import Run
 
 __all__ = ["COMPARISON_SCHEMA", "PHASES_KEY", "PhaseListing", "comparison", "fmt", "phase_listing"]
@@ -162,6 +172,8 @@ def _baseline_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
 _PHASE_KEYS = (
     "included_angle_min_deg",
     "included_angle_max_deg",
+    "included_angle_projected_min_deg",
+    "included_angle_projected_max_deg",
     "range_of_motion_mm",
     "range_of_motion_peak_to_peak_mm",
     "most_deformed_joint",
@@ -169,35 +181,34 @@ _PHASE_KEYS = (
 
 
 def _phase_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
-    """Table 3's rows: included angles, the two ranges of motion and the most deformed joint."""
+    """Table 3's rows: the most deformed joint k, the included angles at hinge k and link k's ranges of motion."""
     if "links" not in run.tables:
         return {k: _Value(None, "not computed: the run did not record the links table") for k in _PHASE_KEYS}
-    found, _ = phases(run, facts)
-    if not found:
+    motion = table3_motion(run, facts)
+    if motion is None:
         return {k: _Value(None, "not computed: none of the four phases lies in the run") for k in _PHASE_KEYS}
-    listing = phase_listing(run, facts)
+    listing = phase_listing(run, facts, motion)
     assert listing is not None  # a phase was found
     where = listing.note
-    chosen = most_frequent([p.most_deformed for p in found], [p.offset_mm for p in found])
-    angles = [p.included_angle for p in found]
-    hinges = ", ".join(str(p.most_deformed) for p in found)
-    angle_where = f"hinges {hinges} at the phases; {where}"
-    if any(p.most_deformed == 12 for p in found):
+    k, ours = motion.joint, motion.values()
+    angle_where = f"hinge {k} at every phase; {where}"
+    if k == 12:
         angle_where = f"hinge 12's next body is the lower connector, not a link; {angle_where}"
+    angles = {key: _Value(ours[key], f"{DEFINITIONS[key]}; {angle_where}") for key in _PHASE_KEYS[:4]}
+    for key in _PHASE_KEYS[2:4]:
+        if ours[key] is None:
+            angles[key] = _Value(None, "not computed: hinge 12's projection needs the lower connector's axis (bodies)")
     clearance = (
         f"radial clearance {1e3 * facts.clearance:.1f} mm = (tube bore {2e3 * facts.tube_inner_radius:.0f} mm - "
         f"link diameter {2e3 * facts.link_radius:.0f} mm) / 2"
     )
     return {
-        "included_angle_min_deg": _Value(min(angles), f"{DEFINITIONS['included_angle_min_deg']}; {angle_where}"),
-        "included_angle_max_deg": _Value(max(angles), f"{DEFINITIONS['included_angle_max_deg']}; {angle_where}"),
+        **angles,
         "range_of_motion_mm": _Value(
-            max(p.offset_mm for p in found), f"{DEFINITIONS['range_of_motion_mm']}; {clearance}; {where}"
+            ours["range_of_motion_mm"], f"{DEFINITIONS['range_of_motion_mm']}; link {k}; {clearance}; {where}"
         ),
-        "range_of_motion_peak_to_peak_mm": _excursion_value(run, facts, chosen, found, clearance),
-        "most_deformed_joint": _Value(
-            float(chosen.link), f"{DEFINITIONS['most_deformed_joint']}; {_choice_note(chosen, found)}; {where}"
-        ),
+        "range_of_motion_peak_to_peak_mm": _excursion_value(facts, motion, clearance),
+        "most_deformed_joint": _Value(float(k), f"{DEFINITIONS['most_deformed_joint']}; {_choice_note(motion)}"),
     }
 
 
@@ -205,7 +216,7 @@ def _phase_values(run: Run, facts: SceneFacts) -> dict[str, _Value]:
 class PhaseListing:
     """Table 3's phases in a run: one line per phase, which fall outside it, and the text the notes end with."""
 
-    items: list[str]  # "0° t=1.350 s: link 11, 168.16 deg at hinge 11, 14.76 mm"
+    items: list[str]  # "0° t=1.350 s: link 10, 168.16 deg at hinge 10 (169.02 deg projected ...), 14.76 mm; ..."
     outside: str  # "1 of 4 phases in the run (0°, 90°, 180° fall before t = 0)", or ""
 
     @property
@@ -218,55 +229,60 @@ class PhaseListing:
         return json.dumps({"note": self.note, "phases": self.items, "outside": self.outside}, ensure_ascii=False)
 
 
-def phase_listing(run: Run, facts: SceneFacts) -> PhaseListing | None:
-    """The phases of Table 3 found in the run; ``None`` without a links table or a phase in the run."""
-    if "links" not in run.tables:
+def phase_listing(run: Run, facts: SceneFacts, motion: Table3Motion | None = None) -> PhaseListing | None:
+    """The phases of Table 3 found in the run, with the most deformed joint's values at each.
+
+    ``None`` without a links table, a phase in the run or a bend in the last
+    revolution. `motion` is `table3_motion` of the run, computed when not given.
+    """
+    motion = motion if motion is not None else table3_motion(run, facts)
+    if motion is None:
         return None
-    found, skipped = phases(run, facts)
-    if not found:
-        return None
+    k = motion.joint
     items = [
-        f"{p.label} t={p.t:.3f} s: link {p.most_deformed}, {p.included_angle:.2f} deg at hinge {p.most_deformed}, "
-        f"{p.offset_mm:.2f} mm"
-        for p in found
+        f"{p.label} t={p.t:.3f} s: link {k}, {angle:.2f} deg at hinge {k} ({projected:.2f} deg projected on the "
+        f"bend plane), {offset:.2f} mm; furthest out: link {p.furthest} ({p.furthest_offset_mm:.2f} mm)"
+        for p, angle, projected, offset in zip(motion.found, motion.angles, motion.projected, motion.offsets_mm, strict=True)
     ]
-    outside = f"{len(found)} of 4 phases in the run ({', '.join(skipped)} fall before t = 0)" if skipped else ""
+    skipped = motion.skipped
+    outside = f"{len(motion.found)} of 4 phases in the run ({', '.join(skipped)} fall before t = 0)" if skipped else ""
     return PhaseListing(items, outside)
 
 
-def _choice_note(chosen: MostFrequent, found: list[Phase]) -> str:
-    """How the most frequent link was chosen from the phases' links."""
-    links = ", ".join(str(p.most_deformed) for p in found)
-    text = f"per-phase most deformed links {links}: link {chosen.link} at {chosen.count} of {len(found)} phases"
-    if chosen.tie:
-        largest = max(p.offset_mm for p in found if p.most_deformed == chosen.link)
-        tied = ", ".join(map(str, chosen.tied))
-        text += (
-            f"; tie between links {tied} ({chosen.count} each): link {chosen.link} has the largest offset "
-            f"({largest:.2f} mm)"
-        )
+def _ranking_text(ranking: BendRanking, what: str) -> str:
+    """``what start-end s (n frames): hinge a 11.07 deg, hinge b …, margin …`` of a `BendRanking`."""
+    top = ", ".join(f"hinge {h} {ranking.mean_bend[h]:.2f} deg" for h in ranking.order[:3])
+    text = f"{what} {ranking.start:.3f}-{ranking.end:.3f} s ({ranking.frames} frames): {top}"
+    if ranking.runner_up is not None:
+        text += f"; margin over the runner-up {ranking.margin:.3f} deg"
     return text
 
 
-def _excursion_value(run: Run, facts: SceneFacts, chosen: MostFrequent, found: list[Phase], clearance: str) -> _Value:
+def _choice_note(motion: Table3Motion) -> str:
+    """How the most deformed joint was chosen: the leading mean bends, the margin, the revolution before."""
+    text = _ranking_text(motion.ranking, "mean bends over the last revolution")
+    if motion.before is not None and motion.before.winner is not None:
+        text += f"; {_ranking_text(motion.before, 'over the revolution before')}"
+    furthest = ", ".join(str(p.furthest) for p in motion.found)
+    return f"{text}; the link centres furthest out at the phases: links {furthest}"
+
+
+def _excursion_value(facts: SceneFacts, motion: Table3Motion, clearance: str) -> _Value:
     """Peak-to-peak excursion of the most deformed link's centre over the last revolution [mm]."""
-    start, end = last_revolution(facts)
-    paths = centre_paths(run, start, end)
+    (start, end), paths = motion.window, motion.paths
     if paths is None:
         return _Value(None, "not computed: no frame of the links table in the last revolution")
     covered = f"last revolution {start:.3f}-{end:.3f} s, {paths.frames} frames"
     if paths.start > start + 0.5 * facts.output_interval + 1e-9:
         covered += f" (the run holds only {paths.end - paths.start:.3f} s of it)"
-    k = chosen.link
+    k = motion.joint
     value = 1e3 * paths.peak_to_peak(k)
-    phase_links = sorted({p.most_deformed for p in found})
-    others = ", ".join(f"link {j}: {1e3 * paths.peak_to_peak(j):.2f} mm" for j in phase_links)
     widest = max(paths.links, key=lambda j: np.nan_to_num(paths.peak_to_peak(j), nan=-1.0))
     return _Value(
         value,
         f"{DEFINITIONS['range_of_motion_peak_to_peak_mm']}; link {k} over the {covered}: excursion {value:.2f} mm, "
-        f"largest centre offset {1e3 * paths.largest_offset(k):.2f} mm ({clearance}); excursions of the phases' "
-        f"links: {others}; largest of any link: link {widest} ({1e3 * paths.peak_to_peak(widest):.2f} mm)",
+        f"largest centre offset {1e3 * paths.largest_offset(k):.2f} mm ({clearance}); largest excursion of any "
+        f"link: link {widest} ({1e3 * paths.peak_to_peak(widest):.2f} mm)",
     )
 
 
@@ -277,6 +293,7 @@ def _tube_values(run: Run) -> dict[str, _Value]:
         "tube_normal_mean_joint12_n",
         "tube_normal_mean_all_n",
         "tube_tangential_mean_all_n",
+        "tube_normal_mean_max_inclination_deg",
     )
     tube = link_tube_forces(run)
     if tube is None or not tube.normal_mean:
@@ -301,7 +318,8 @@ def _tube_values(run: Run) -> dict[str, _Value]:
     out = {
         "tube_normal_peak_joint10_n": row(10, tube.normal_peak, "tube_normal_peak_joint10_n", peak_extra),
         "tube_normal_mean_joint10_n": row(10, tube.normal_mean, "tube_normal_mean_joint10_n", mean_extra),
-        "tube_normal_mean_joint12_n": row(12, tube.normal_mean, "tube_normal_mean_joint12_n"),
+        "tube_normal_mean_joint12_n": row(12, tube.normal_mean, "tube_normal_mean_joint12_n", link12_text(run)),
+        "tube_normal_mean_max_inclination_deg": _Value(*distribution_row(run)),
     }
     for kind, means in (("normal", tube.normal_mean), ("tangential", tube.tangential_mean)):
         key = f"tube_{kind}_mean_all_n"
@@ -314,44 +332,38 @@ def _tube_values(run: Run) -> dict[str, _Value]:
 
 
 def _internal_values(run: Run) -> dict[str, _Value]:
-    out: dict[str, _Value] = {}
-    times = frame_times(run)
-    out.update(_cage_values(run, times))
-    keys = run.tables.get("keys")
-    specs = {
-        "cage_key_normal_peak_n": "window_normal",
-        "seat_key_normal_peak_n": "outer_normal",
-        "seat_key_tangential_peak_n": "outer_tangential",
-    }
-    if keys is None:
-        for key in specs:
-            out[key] = _Value(None, "not computed: the run did not record the keys table")
+    """Peak cage and key forces over hinges, keys and frames [N] (`ballcage.measures.quantities.column_peaks`)."""
+    out = _cage_values(run)
+    peaks = column_peaks(run, "keys", ["hinge", "key"], KEY_PEAKS)
+    if peaks is None:
+        out.update({key: _Value(None, "not computed: the run did not record the keys table") for key in KEY_PEAKS})
         return out
-    grids = frame_grid(keys, times, ["hinge", "key"], list(specs.values()))
-    for key, column in specs.items():
-        v, ids, t = argmax_where(grids[column], times)
-        where = f"; at hinge {ids[0]:02d} key {ids[1]}, t = {t:.4g} s" if ids else ""
-        out[key] = _Value(v, f"{DEFINITIONS[key]}{where}")
+    for key, peak in peaks.items():
+        where = f"; at hinge {peak.ids[0]:02d} key {peak.ids[1]}, t = {peak.t:.4g} s" if peak.ids else ""
+        place = peak_place(run, peak.column) if key == "seat_key_normal_peak_n" and peak.ids else None
+        if place is not None:
+            where = f"; {key_place_text(place)}"
+        out[key] = _Value(peak.value, f"{DEFINITIONS[key]}{where}")
     return out
 
 
-def _cage_values(run: Run, times: np.ndarray) -> dict[str, _Value]:
+def _cage_values(run: Run) -> dict[str, _Value]:
     """Peak cage-seat and cage-head normal forces over hinges and frames [N]."""
-    specs = {"seat_cage_normal_peak_n": "cage_seat_normal", "head_cage_normal_peak_n": "cage_head_normal"}
-    hinges = run.tables.get("hinges")
-    if hinges is None:
-        return {k: _Value(None, "not computed: the run did not record the hinges table") for k in specs}
-    if run.scene.value("pipe.hinge") != "ball-keys":
+    if "hinges" not in run.tables:
+        return {k: _Value(None, "not computed: the run did not record the hinges table") for k in CAGE_PEAKS}
+    peaks: dict[str, Peak] | None = None
+    if run.scene.value("pipe.hinge") == "ball-keys":
+        peaks = column_peaks(run, "hinges", ["hinge"], CAGE_PEAKS)
+    if peaks is None:
         why = f"not computed: pipe.hinge = {run.scene.value('pipe.hinge')!r} has no cages"
-        return {k: _Value(None, why) for k in specs}
-    grids = frame_grid(hinges, times, ["hinge"], list(specs.values()))
-    peaks = {key: argmax_where(grids[column], times) for key, column in specs.items()}
+        return {k: _Value(None, why) for k in CAGE_PEAKS}
     out = {}
-    for key, (v, ids, t) in peaks.items():
-        where = f"; at hinge {ids[0]:02d}, t = {t:.4g} s" if ids else ""
+    for key, peak in peaks.items():
+        where = f"; at hinge {peak.ids[0]:02d}, t = {peak.t:.4g} s" if peak.ids else ""
         other = "head_cage_normal_peak_n" if key == "seat_cage_normal_peak_n" else "seat_cage_normal_peak_n"
         side = "head" if other.startswith("head") else "seat"
-        out[key] = _Value(v, f"{DEFINITIONS[key]}{where}; the cage-{side} peak is {fmt(peaks[other][0])} N ({other})")
+        text = f"{DEFINITIONS[key]}{where}; the cage-{side} peak is {fmt(peaks[other].value)} N ({other})"
+        out[key] = _Value(peak.value, text)
     return out
 
 
@@ -362,21 +374,13 @@ def _sweep_value(run: Run, variant: str, what: str) -> _Value:
         tube = link_tube_forces(run)
         if tube is None or not tube.normal_mean:
             return _Value(None, "not computed: the sweep run did not record the links table")
+        profile = tube_profile(run)
         link = max(tube.normal_mean, key=lambda k: tube.normal_mean[k])
-        links = run.tables["links"]
-        mask = links.column("link").to_numpy() == link
-        incl = f", mean inclination {float(np.mean(links.column('inclination_deg').to_numpy()[mask])):.1f} deg"
+        incl = f", mean inclination {profile.inclination[link]:.1f} deg" if profile is not None else ""
         return _Value(tube.normal_mean[link], f"{definition}; at link {link}{incl}")
-    keys = run.tables.get("keys")
-    if keys is None:
+    peak = race_peak(run)
+    if peak is None:
         return _Value(None, "not computed: the sweep run did not record the keys table")
-    times = frame_times(run)
-    grids = frame_grid(keys, times, ["hinge", "key"], ["inner_normal", "outer_normal"])
-    best: tuple[float, tuple[int, ...], float, str] = (math.nan, (), math.nan, "")
-    for column, race in (("inner_normal", "head race"), ("outer_normal", "seat race")):
-        v, ids, t = argmax_where(grids[column], times)
-        if math.isfinite(v) and not (v <= best[0]):
-            best = (v, ids, t, race)
-    v, ids, t, race = best
-    where = f"; at hinge {ids[0]:02d} key {ids[1]} ({race}), t = {t:.4g} s" if ids else ""
-    return _Value(v, f"{definition}{where}")
+    race = {"inner_normal": "head race", "outer_normal": "seat race"}.get(peak.column, "")
+    where = f"; at hinge {peak.ids[0]:02d} key {peak.ids[1]} ({race}), t = {peak.t:.4g} s" if peak.ids else ""
+    return _Value(peak.value, f"{definition}{where}")

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 from importlib import resources
 from typing import Any
 
+from ballcage.measures.quantities import MEASURES
+
 __all__ = [
     "BASELINE_RADIUS",
     "BASELINE_RPM",
@@ -20,6 +22,7 @@ __all__ = [
     "SWEEPS",
     "SWEEP_DEFINITIONS",
     "TREND_RULES",
+    "TUBE_DISTRIBUTION_PAPER",
     "TUBE_LINKS",
     "ExtraRow",
     "SweepVariant",
@@ -84,43 +87,51 @@ class ExtraRow:
 
 #: Rows beyond the reference file's, in the order they follow their `after` keys.
 EXTRA_ROWS: tuple[ExtraRow, ...] = (
+    ExtraRow("included_angle_projected_min_deg", "included_angle_min_deg", "deg", "included_angle_min_deg"),
+    ExtraRow("included_angle_projected_max_deg", "included_angle_max_deg", "deg", "included_angle_max_deg"),
     ExtraRow("range_of_motion_peak_to_peak_mm", "range_of_motion_mm", "mm", "range_of_motion_mm"),
+    ExtraRow("tube_normal_mean_max_inclination_deg", "tube_normal_mean_joint12_n", "deg", None),
     ExtraRow("head_cage_normal_peak_n", "seat_cage_normal_peak_n", "N", None),
+)
+#: What the paper says about where along the chain the tube force is largest (the note of
+#: ``tube_normal_mean_max_inclination_deg``; docs/model.md §6.2).
+TUBE_DISTRIBUTION_PAPER = (
+    "the paper: the largest per-joint mean at joint 10 (876.8 N, section 3.2; joint 10's chord lies at 72.6 deg "
+    "of inclination on the arc), 'largest at 30-70 deg slope' in its text, 58-78 deg in its section 4 cases (78 deg at R = 1.0 m, 58 deg "
+    "at R = 2.5 m, 75 deg at 60 rpm, 60 deg at 120 rpm), and 0 N at joint 12"
 )
 #: Links whose tube forces the paper plots (Figs. 10–11) and quotes.
 TUBE_LINKS: tuple[int, ...] = (2, 4, 6, 8, 10)
 
-#: How we compute each reference quantity; repeated in the row's note.
+
+def _ours(key: str) -> str:
+    """How we compute `key`, as measured in `ballcage.measures.quantities.MEASURES`, with ``ours: `` before it."""
+    text = MEASURES[key]
+    return text if text.startswith("differs: ") else f"ours: {text}"
+
+
+_TABLE3 = (
+    "included_angle_min_deg",
+    "included_angle_max_deg",
+    "included_angle_projected_min_deg",
+    "included_angle_projected_max_deg",
+    "range_of_motion_mm",
+    "range_of_motion_peak_to_peak_mm",
+    "most_deformed_joint",
+)
+_SUMS_AND_PEAKS = (
+    "tube_normal_mean_all_n",
+    "tube_tangential_mean_all_n",
+    "seat_cage_normal_peak_n",
+    "head_cage_normal_peak_n",
+    "cage_key_normal_peak_n",
+    "seat_key_normal_peak_n",
+    "seat_key_tangential_peak_n",
+)
+#: How we compute each reference quantity; repeated in the row's note. The quantities a sweep's summary also
+#: holds are defined once, in `ballcage.measures.quantities.MEASURES`.
 DEFINITIONS: dict[str, str] = {
-    "included_angle_min_deg": (
-        "ours: at each phase, the included angle at hinge k between link k and link k+1 (as in Fig. 9: "
-        "links.included_angle_deg of link k = 180 - hinges.bend_deg of hinge k; hinges 1-11 join two links, hinge 12 "
-        "joins link 12 and the lower connector), k = the most deformed link there (largest links.radial_offset); "
-        "smallest over the phases"
-    ),
-    "included_angle_max_deg": (
-        "ours: at each phase, the included angle at hinge k between link k and link k+1 (links.included_angle_deg "
-        "of link k; hinge 12 joins link 12 and the lower connector), k = the most deformed link there (largest "
-        "links.radial_offset); largest over the phases"
-    ),
-    "range_of_motion_mm": (
-        "differs: ours is the largest centre offset, the most deformed link's centre-of-mass distance from the "
-        "tube centreline (links.radial_offset, mm), largest over the phases; a centre offset cannot exceed the "
-        "radial clearance, so the paper's 23.6 / 24.5 / 25.0 / 25.3 mm (Table 3) can only be an excursion: "
-        "range_of_motion_peak_to_peak_mm is the definition that fits the paper"
-    ),
-    "range_of_motion_peak_to_peak_mm": (
-        "ours: peak-to-peak excursion of the most deformed link's centre (most_deformed_joint) over the last "
-        "revolution of the upper connector: the largest distance between two positions of the centre in the tube "
-        "cross-section (links.offset_outward, links.offset_lateral, i.e. projected on the plane normal to the "
-        "tube centreline), mm; this is the definition that fits the paper's 23.6-25.3 mm, which exceed the "
-        "radial clearance a centre offset is bounded by"
-    ),
-    "most_deformed_joint": (
-        "ours: the link with the largest links.radial_offset at each phase; reported as the most frequent over "
-        "the phases (a tie goes to the tied link with the largest offset), never a mean of link numbers; by this rule "
-        "the paper's own phases (Table 3: 4, 6, 5, 4) give 4, while the reference file holds 5, their middle"
-    ),
+    **{key: _ours(key) for key in _TABLE3},
     "tube_normal_peak_joint10_n": (
         "ours: largest links.tube_normal of link 10 (per-frame total normal force of its contact with the tube) "
         "over the frames of the summary window"
@@ -130,32 +141,8 @@ DEFINITIONS: dict[str, str] = {
         "contact count as 0)"
     ),
     "tube_normal_mean_joint12_n": "ours: mean of links.tube_normal of link 12 over the frames of the summary window",
-    "tube_normal_mean_all_n": (
-        "differs: ours is the SUM over links 1-12 of the mean links.tube_normal over the summary window "
-        "(reading 1: a sum, the only reading that can exceed a single joint's peak)"
-    ),
-    "tube_tangential_mean_all_n": (
-        "differs: ours is the SUM over links 1-12 of the mean links.tube_tangential over the summary window "
-        "(magnitude of the per-frame summed friction vector; reading 1: a sum)"
-    ),
-    "seat_cage_normal_peak_n": (
-        "ours: maximum of hinges.cage_seat_normal (ball seat-ball cage) over all hinges and frames"
-    ),
-    "head_cage_normal_peak_n": (
-        "ours: maximum of hinges.cage_head_normal (ball head-ball cage) over all hinges and frames; the paper reports "
-        "no value (section 3.3 quotes only ball seat-ball cage, 23.8 kN, and calls the ball head's contacts "
-        "approximately equal to the seat's)"
-    ),
-    "cage_key_normal_peak_n": (
-        "ours: maximum of keys.window_normal (cage window faces, both window pairs of one key summed) "
-        "over all keys and frames"
-    ),
-    "seat_key_normal_peak_n": (
-        "ours: maximum of keys.outer_normal (seat race, both flanks of one key summed) over all keys and frames"
-    ),
-    "seat_key_tangential_peak_n": (
-        "ours: maximum of keys.outer_tangential (seat race friction magnitude) over all keys and frames"
-    ),
+    "tube_normal_mean_max_inclination_deg": _ours("tube_normal_mean_max_inclination_deg"),
+    **{key: _ours(key) for key in _SUMS_AND_PEAKS},
 }
 SWEEP_DEFINITIONS: dict[str, str] = {
     "tube_mean_max": (

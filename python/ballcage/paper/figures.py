@@ -13,8 +13,8 @@ import numpy as np
 from ballcage._files import write_png
 from ballcage._plot import figure, no_data, series_styles
 from ballcage.paper.definitions import TUBE_LINKS
-from ballcage.paper.facts import SceneFacts, phases, scene_facts
-from ballcage.paper.frames import frame_grid, frame_times
+from ballcage.measures.phases import SceneFacts, phases, scene_facts
+from ballcage.measures.frames import frame_grid, frame_times
 from ballcage.run import Run
 
 if TYPE_CHECKING:
@@ -103,7 +103,7 @@ def _fig_included_angles(run: Run, facts: SceneFacts, times: np.ndarray) -> Figu
             0.01, 0.01, f"phases before t = 0 not shown: {', '.join(skipped)}", transform=by_hinge.transAxes, fontsize=7
         )
     by_hinge.set(
-        xlabel="hinge k [-] (1-11: link k / link k+1; hollow 12: link 12 / lower connector)",
+        xlabel="hinge k [-]\n(1-11: link k / link k+1; hollow 12: link 12 / lower connector)",
         ylabel="included angle at hinge k [deg]",
         title="At the four phases of the last revolution",
     )
@@ -140,7 +140,7 @@ def _fig_tube(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
         for k in TUBE_LINKS:
             if k < forces.shape[1]:
                 ax.plot(times, forces[:, k], lw=1, label=f"link {k}")
-        ax.legend(title=f"links.{column}", fontsize=8)
+        ax.legend(title=f"links.{column}", fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # off the lines
     else:
         no_data(ax, "no links table")
     ax.set(xlabel="time [s]", ylabel=f"{kind} contact force link-tube [N]")
@@ -171,7 +171,7 @@ def _race_label(body: str | int, races: list[tuple[int, str]]) -> str:
 
 
 def _fig_keys(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
-    fig = figure(figsize=(10, 5.2))
+    fig = figure(figsize=(10, 6.2))
     ax = fig.subplots()
     keys = run.tables.get("keys")
     kind = "normal" if normal else "tangential"
@@ -185,7 +185,7 @@ def _fig_keys(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
                 continue
             largest = np.nanmax(np.concatenate(series, axis=1), axis=1)
             ax.plot(times, largest, lw=1, label=_race_label(body, races))
-        ax.legend(fontsize=7, loc="best")
+        fig.legend(fontsize=7, loc="outside lower center", ncol=2)  # below the axes: off the lines
     else:
         no_data(ax, "no keys table")
     ax.set(xlabel="time [s]", ylabel=f"largest ball-key {kind} force [N]")
@@ -201,7 +201,7 @@ def _fig_keys(run: Run, times: np.ndarray, *, normal: bool) -> Figure:
 
 
 def _fig_shape(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
-    fig = figure(figsize=(12, 7.5))
+    fig = figure(figsize=(12, 8))
     grid_spec = fig.add_gridspec(2, 4, height_ratios=[1.1, 1])
     sections = [fig.add_subplot(grid_spec[0, i]) for i in range(4)]
     profile = fig.add_subplot(grid_spec[1, :])
@@ -216,15 +216,15 @@ def _fig_shape(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
         numbers = np.arange(1, offsets.shape[1] + 1)
         for ax, (label, t) in zip(sections, facts.phase_times(), strict=True):
             p = by_label.get(label)
-            _section_axes(ax, clearance_mm)
+            _section_axes(ax, clearance_mm, first=ax is sections[0])
             if p is None:
-                ax.set_title(f"{label}: t = {t:.3f} s not in run", fontsize=9)
+                ax.set_title(f"{label}: t = {t:.3f} s\nnot in the run", fontsize=9)
                 continue
             x_mm, y_mm = 1e3 * outward[p.frame], 1e3 * lateral[p.frame]
             sc = ax.scatter(x_mm, y_mm, c=numbers, cmap="viridis", s=22, zorder=3)
             for k, x, y in zip(numbers, x_mm, y_mm, strict=True):
                 ax.annotate(str(k), (x, y), fontsize=6, xytext=(2, 2), textcoords="offset points")
-            ax.set_title(f"{label}: t = {p.t:.3f} s, max link {p.most_deformed}", fontsize=9)
+            ax.set_title(f"{label}: t = {p.t:.3f} s\nfurthest out: link {p.furthest}", fontsize=9)
             profile.plot(numbers, 1e3 * offsets[p.frame], marker="o", label=f"{label} (t = {p.t:.3f} s)")
         if found:
             fig.colorbar(sc, ax=sections, label="link number [-]", shrink=0.8)
@@ -232,28 +232,38 @@ def _fig_shape(run: Run, facts: SceneFacts, times: np.ndarray) -> Figure:
     else:
         no_data(profile, "no links table")
     profile.axhline(clearance_mm, color="k", ls="--", lw=0.8, label=f"clearance {clearance_mm:.0f} mm")
+    profile.set_ylim(bottom=0.0)  # offsets are distances from the centreline: 0 is on the axis
     profile.set(
         xlabel="link number k [-]",
-        ylabel="centre offset from tube centreline [mm]",
+        ylabel="centre offset from\ntube centreline [mm]",
         title="Radial offset of each link's centre of mass (links.radial_offset)",
     )
-    profile.legend(fontsize=8)
+    # Below the figure, in one row: off the lines, and not in the right margin the colour bar takes.
+    fig.legend(*profile.get_legend_handles_labels(), fontsize=8, loc="outside lower center", ncol=5)
     fig.suptitle(
         "Table 3: chain shape at the phases 0/90/180/270 deg of the upper connector's last revolution "
-        f"({facts.rpm:g} rpm; dashed circle: tube clearance {clearance_mm:.0f} mm)",
+        f"({facts.rpm:g} rpm)\ncross-sections seen down the tube: x in the bend plane, + toward the outer wall; "
+        f"dashed circle: tube clearance {clearance_mm:.0f} mm; numbers: link k",
         fontsize=10,
     )
     return fig
 
 
-def _section_axes(ax: Axes, clearance_mm: float) -> None:
-    """A tube cross-section [mm]: the clearance circle, equal axes, + toward the outer wall of the bend."""
+def _section_axes(ax: Axes, clearance_mm: float, *, first: bool) -> None:
+    """A tube cross-section [mm]: the clearance circle, equal axes, + toward the outer wall of the bend.
+
+    The four sections share their limits; only the `first` labels the y axis, so the
+    labels of one panel never run into the next (the suptitle says what x and y are).
+    """
     circle = np.linspace(0.0, 2.0 * math.pi, 181)
     ax.plot(clearance_mm * np.cos(circle), clearance_mm * np.sin(circle), "k--", lw=0.8)
     ax.set_aspect("equal")
     ax.set(
-        xlabel="links.offset_outward [mm]\n(in the bend plane, + toward the outer wall)",
-        ylabel="links.offset_lateral [mm]",
+        xlabel="links.offset_outward [mm]",
         xlim=(-1.15 * clearance_mm, 1.15 * clearance_mm),
         ylim=(-1.15 * clearance_mm, 1.15 * clearance_mm),
     )
+    if first:
+        ax.set_ylabel("links.offset_lateral [mm]")
+    else:
+        ax.tick_params(labelleft=False)

@@ -10,7 +10,8 @@ import pyarrow as pa
 
 from ballcage.paper.compare import PHASES_KEY, fmt
 from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS, reference
-from ballcage.paper.facts import scene_facts
+from ballcage.paper.places import place_lines
+from ballcage.measures.phases import scene_facts
 from ballcage.run import Run
 
 __all__ = ["comparison_markdown", "duty_lines"]
@@ -65,6 +66,8 @@ def comparison_markdown(
         note = note.replace("|", "\\|")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
     lines += _phase_lines(phases)
+    if run is not None:
+        lines += place_lines(run)
     if run is not None and "wear" in run.tables:
         lines += duty_lines(run)
     if section4 is not None:
@@ -115,8 +118,9 @@ def _phase_lines(phases: Mapping[str, Any]) -> list[str]:
     lines = [
         "",
         "Phases of Table 3, the upper connector's angle in its last revolution (the rows above marked "
-        '"phases: listed under the table"): at each, the most deformed link (largest links.radial_offset), '
-        "the included angle at its hinge and its centre offset.",
+        '"phases: listed under the table"): at each, the most deformed joint k (the hinge with the largest mean '
+        "bend over the last revolution), the included angle at hinge k, in 3-D and projected on the bend plane, "
+        "link k's centre offset, and the link whose centre is furthest out there.",
         "",
     ]
     lines += [f"- {item}" for item in phases["phases"]]
@@ -133,6 +137,6 @@ def _extra_rows_sentence() -> str:
     ]
     return (
         f"Rows the reference file lacks follow the row they belong to: {', '.join(parts)}; "
-        "the phases behind Table 3's rows (most deformed link, included angle at hinge k between link k and link k+1, "
-        "range of motion) are listed once, under the table."
+        "the phases behind Table 3's rows (the most deformed joint k, the included angle at hinge k between link k "
+        "and link k+1, link k's range of motion) are listed once, under the table."
     )

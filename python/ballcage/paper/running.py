@@ -10,14 +10,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
-from ballcage._native import InputError
 from ballcage._files import write_parquet, write_text
+from ballcage.duty import write_loss_figure
 from ballcage.paper.compare import comparison
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.run import simulate
-from ballcage.duty import write_loss_figure
-from ballcage.scene import default_scene
+from ballcage.scene import default_scene, override_list
 from ballcage.view import write_view
 
 if TYPE_CHECKING:
@@ -48,7 +47,7 @@ def run_paper(
     """Runs the paper scene and writes tables, figures and the comparison into `out_dir`.
 
     `overrides` (``dotted.key=value``, on the drill-pipe TOML of
-    `ballcage.default_scene_toml`) apply to the main run and to every case of
+    `ballcage.scene.default_scene_toml`) apply to the main run and to every case of
     the section-4 sweep, whose own keys (curvature radius, drive speed) are
     applied last. `progress` is as for `ballcage.simulate` and `ballcage.sweep`.
     Every scene is validated before anything runs.
@@ -70,11 +69,9 @@ def run_paper(
     when the main run diverges (a sweep case that diverges is recorded in the
     sweep's summary and its rows stay empty).
     """
-    if isinstance(overrides, str):
-        raise InputError("overrides is a list of 'key=value' strings, not one string")
     from ballcage.paper.section4 import section4_spec  # deferred: the sweep machinery imports this package
 
-    user = list(overrides)
+    user = override_list(overrides)
     out = Path(out_dir)
     main_scene = paper_scene(user)
     spec = section4_spec(user) if sweeps else None
@@ -124,10 +121,8 @@ def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     Raises `ballcage.SceneError` for an invalid override or a ``record.tables``
     override that drops a table the analysis needs.
     """
-    if isinstance(overrides, str):
-        raise InputError("overrides is a list of 'key=value' strings, not one string")
     record = "record.tables=[" + ", ".join(f'"{t}"' for t in PAPER_TABLES) + "]"
-    scene = default_scene([record, *overrides])
+    scene = default_scene([record, *override_list(overrides)])
     missing = [t for t in PAPER_TABLES if t not in scene.table_names]
     if missing:
         reason = f"must include {', '.join(missing)} for the paper's figures and comparison"

@@ -1,5 +1,8 @@
 """The paper's §4.2–4.3 as one sweep (``ballcage paper --sweeps``), on the sweep machinery of `ballcage.sweep`.
 
+Each case records the drill pipe's quantities (`ballcage.measures.DRILL_PIPE`);
+none runs the paper's comparison.
+
 The cases, on the paper scene with the user's overrides:
 
 - §4.2: ``borehole.curvature_radius`` = `SECTION4_RADII` (1.0–2.5 m) at 100 rpm;
@@ -26,11 +29,11 @@ from typing import Any
 from ballcage import _native
 from ballcage._native import InputError
 from ballcage._links import summary_window
+from ballcage.measures.quantities import DRILL_PIPE
 from ballcage.paper.definitions import BASELINE_RADIUS, BASELINE_RPM, SECTION4_RADII, SECTION4_SPEEDS, SWEEPS
 from ballcage.run import Run
 from ballcage.scene import default_scene
 from ballcage.studies.sweep_case import read_case_run
-from ballcage.studies.sweep_quantities import case_quantities
 from ballcage.studies.sweep_run import SweepResult, sweep
 from ballcage.studies.sweep_spec import DEFAULT_TABLES, SweepSpec
 
@@ -76,14 +79,14 @@ class Section4:
     def window_rows(self, window: tuple[float, float]) -> list[dict[str, Any]]:
         """Summary-like rows of the finished cases with their quantities averaged over `window` [s] instead.
 
-        Recomputed from the recorded tables (`case_quantities` on each run with
+        Recomputed from the recorded tables (`ballcage.measures.DRILL_PIPE` on each run with
         ``record.summary_window`` replaced): nothing is run again.
         """
         rows = []
         for (radius, rpm), run in self.runs.items():
             scene = _native.Scene.from_toml(run.scene_toml, [f"record.summary_window=[{window[0]!r}, {window[1]!r}]"])
             moved = Run(run.tables, scene.to_toml(), error=run.error, scene=scene)
-            rows.append({"status": "ok", RADIUS_KEY: radius, RPM_KEY: rpm, **case_quantities(moved)})
+            rows.append({"status": "ok", RADIUS_KEY: radius, RPM_KEY: rpm, **DRILL_PIPE(moved)})
         return rows
 
     def other_windows(self) -> dict[str, list[dict[str, Any]]]:
@@ -129,8 +132,12 @@ def run_section4(
     workers: int | None = None,
     progress: bool | None = None,
 ) -> Section4:
-    """Runs (or resumes) the section-4 sweep `spec` into `out` and reads back its finished cases' runs."""
-    result = sweep(spec, out, client=client, workers=workers, progress=progress)
+    """Runs (or resumes) the section-4 sweep `spec` into `out` and reads back its finished cases' runs.
+
+    Each case's quantities are the drill pipe's (`ballcage.measures.DRILL_PIPE`), the summary columns
+    the trends are checked on; the comparison's own rows are built once, from the variants' runs.
+    """
+    result = sweep(spec, out, client=client, workers=workers, progress=progress, quantities=DRILL_PIPE)
     runs: dict[tuple[float, float], Run] = {}
     for row in result.summary.to_pylist():
         if row["status"] == "ok":

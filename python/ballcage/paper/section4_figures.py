@@ -28,10 +28,19 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
-__all__ = ["SECTION4_FIGURES", "hinge_key_peaks", "link_inclinations", "write_section4_figures"]
+__all__ = ["FRICTION_COLUMNS", "SECTION4_FIGURES", "friction_split", "hinge_key_peaks", "link_inclinations",
+           "write_section4_figures"]
 
 #: Figure files (without ``.png``).
 SECTION4_FIGURES: tuple[str, ...] = ("fig16_curvature", "fig17_speed", "losses_curvature")
+#: The drive table's friction power per frame [W] by contact group (the groups of `ballcage.duty.loss_breakdown`).
+FRICTION_COLUMNS: dict[str, str] = {
+    "tube": "friction_tube",
+    "key–race": "friction_key_race",
+    "key–window": "friction_key_window",
+    "cage": "friction_cage",
+    "neck": "friction_neck",
+}
 
 
 def write_section4_figures(
@@ -52,10 +61,25 @@ def write_section4_figures(
     }
 
 
+def friction_split(run: Run) -> dict[str, float] | None:
+    """Mean friction power [W] by contact group (`FRICTION_COLUMNS`) over the summary window, from the drive table.
+
+    The sweep's cases record ``drive`` but not ``wear``; the drive table samples per frame the
+    friction power that the wear table integrates per step (`ballcage.duty.loss_breakdown`).
+    ``None`` without a drive table or without a frame in the window.
+    """
+    drive = run.tables.get("drive")
+    if drive is None or drive.num_rows == 0:
+        return None
+    inside = in_summary_window(run.scene, drive.column("t").to_numpy())
+    if not inside.any():
+        return None
+    return {group: float(drive.column(c).to_numpy()[inside].mean()) for group, c in FRICTION_COLUMNS.items()}
+
+
 def _losses_figure(curvature: Mapping[float, Run]) -> Figure:
-    """Beyond the paper: drive efficiency against R, and the friction loss by contact (`ballcage.duty`) per R."""
-    from ballcage.duty import loss_breakdown
-    from ballcage.studies.sweep_quantities import efficiency
+    """Beyond the paper: drive efficiency against R, and the friction loss by contact (`friction_split`) per R."""
+    from ballcage.measures.quantities import efficiency
 
     fig = figure(figsize=(12, 4.8))
     eff_ax, loss_ax = fig.subplots(1, 2)
@@ -66,8 +90,8 @@ def _losses_figure(curvature: Mapping[float, Run]) -> Figure:
     else:
         no_data(eff_ax, "no finished case")
     eff_ax.set(xlabel="borehole curvature radius R [m]", ylabel="drive efficiency [%]",
-               title="Load-transfer efficiency (mean output / mean input power, summary window)")
-    losses = {r: loss_breakdown(curvature[r].tables["wear"]) for r in radii if "wear" in curvature[r].tables}
+               title="Load-transfer efficiency\n(mean output / mean input power, summary window)")
+    losses = {r: split for r in radii if (split := friction_split(curvature[r])) is not None}
     if losses:
         groups = list(next(iter(losses.values())))
         bottom = np.zeros(len(losses))
@@ -76,11 +100,12 @@ def _losses_figure(curvature: Mapping[float, Run]) -> Figure:
             heights = np.array([losses[r][group] for r in losses])
             loss_ax.bar(list(losses), heights, bottom=bottom, width=width, color=style["color"], label=group)
             bottom += heights
-        loss_ax.legend(fontsize=8)
+        loss_ax.set_xticks(list(losses))
+        loss_ax.legend(fontsize=8, title="contact", title_fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     else:
-        no_data(loss_ax, "no wear table in the cases")
+        no_data(loss_ax, "no drive table in the cases")
     loss_ax.set(xlabel="borehole curvature radius R [m]", ylabel="mean friction power [W]",
-                title="Friction loss by contact (wear window)")
+                title="Friction loss by contact\n(drive.friction_*, summary window)")
     fig.suptitle("Where the power goes against the borehole curvature (100 rpm)", fontsize=10)
     return fig
 
@@ -117,10 +142,12 @@ def _figure(runs: Mapping[str, Run], title: str) -> Figure:
         if peaks:
             keys.plot(list(peaks), [v / 1e3 for v in peaks.values()], label=label, **style)
     for ax, what in ((tube, "no links table"), (keys, "no ball keys (pipe.hinge is not ball-keys)")):
-        if ax.lines:
-            ax.legend(fontsize=8)
-        else:
+        if not ax.lines:
             no_data(ax, what if runs else "no finished case")
+    # One legend for both panels (the same cases), beside them rather than over the lines.
+    handles, labels = max((ax.get_legend_handles_labels() for ax in (tube, keys)), key=lambda hl: len(hl[1]))
+    if handles:
+        fig.legend(handles, labels, loc="outside right upper", fontsize=8)
     tube.set(xlabel="link's mean inclination [deg]", ylabel="mean tube normal force per link [N]",
              title="Link–tube contact (summary window)")
     keys.set(xlabel="hinge [-] (0: upper connector / link 1)", ylabel="peak race normal force on one key [kN]",

@@ -52,11 +52,13 @@ varied), `stability_search` (the stable-step search), `stability_run` and
 `stability_report` (running the stability study; its files); the sweeps
 (``ballcage sweep``, docs/studies.md): `sweep_spec` (the sweep file and its
 cases), `sweep_case` (one case on a worker: run, files, record),
-`sweep_quantities` (a case's derived quantities, by the paper module's
-definitions), `sweep_summary` (``summary.parquet``), `sweep_plots` and
-`sweep_run` (`sweep`: local threads or Dask, resume, progress); the design chart
-(``ballcage chart``): `design_chart` (cells, feasibility, the sweep of the
-feasible ones, ``design_chart.parquet``) and `design_chart_plot` (its figure).
+`sweep_quantities` (the plug-in a sweep computes each case's quantities with,
+`sweep_quantities.SweepQuantities`; the drill pipe's is
+`ballcage.measures.DRILL_PIPE`), `sweep_summary` (``summary.parquet``),
+`sweep_plots` and `sweep_run` (`sweep`: local threads or Dask, resume,
+progress); the design chart (``ballcage chart``): `design_chart_grid` (the
+cells and their feasibility), `design_chart` (the sweep of the feasible ones,
+``design_chart.parquet``) and `design_chart_plot` (its figure).
 """
 
 from ballcage.studies.accuracy_report import accuracy_markdown, write_accuracy

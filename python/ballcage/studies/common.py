@@ -11,7 +11,7 @@ import pyarrow as pa
 
 from ballcage import _native
 from ballcage._native import InputError
-from ballcage.scene import SceneSource, default_scene, load_scene
+from ballcage.scene import SceneSource, default_scene, load_scene, override_list
 
 __all__ = ["StudyError", "available_integrators"]
 
@@ -70,9 +70,8 @@ def is_drill_pipe(scene: _native.Scene) -> bool:
 
 def resolve(scene: SceneSource | None, overrides: Iterable[str]) -> _native.Scene:
     """`scene` (``None``: the embedded paper scene) validated with `overrides`."""
-    if isinstance(overrides, str):
-        raise InputError("overrides is a list of 'key=value' strings, not one string")
-    return default_scene(list(overrides)) if scene is None else load_scene(scene, list(overrides))
+    patches = override_list(overrides)
+    return default_scene(patches) if scene is None else load_scene(scene, patches)
 
 
 def toml_value(value: float | str | Sequence[str]) -> str:

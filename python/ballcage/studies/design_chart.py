@@ -6,10 +6,10 @@ checked before anything runs, by the scene validator of the Rust core (the
 check ``ballcage run`` makes), which refuses a cell that breaks
 
 - eq. (9) of Zhu et al. 2023: a rigid joint L long fits the tube bent to R
-  only if L ≤ 2·√(2(D − d)(R + d/2)) (`ballcage.sizing.longest_joint`), or
+  only if L ≤ 2·√(2(D − d)(R + d/2)) (`ballcage.sizing.longest_link`), or
 - the hinge's articulation limit β_max (`ballcage.Scene.articulation_limit_deg`):
   placed on the arc each hinge bends 2·asin(L / 2R), so R ≥ L / (2·sin(β_max / 2))
-  (`ballcage.sizing.smallest_curvature_radius_for_bend`).
+  (`ballcage.sizing.tightest_radius_for_bend`).
 
 A refused cell is infeasible; its reason names the constraints it breaks
 (both may; the validator reports eq. (9) first) or, for any other refusal,
@@ -51,10 +51,20 @@ import pyarrow as pa
 
 from ballcage import _native, sizing
 from ballcage._files import write_parquet, write_png
-from ballcage.scene import default_scene_toml
-from ballcage.studies.sweep_quantities import QUANTITIES
-from ballcage.studies.sweep_run import SweepResult, pending_cases, scheduler_client, sweep
-from ballcage.studies.sweep_spec import DEFAULT_TABLES, SweepError, SweepSpec, toml_value
+from ballcage.measures.quantities import DRILL_PIPE, QUANTITIES
+from ballcage.studies.design_chart_grid import (
+    LENGTH,
+    MASS,
+    RADIUS,
+    Cell,
+    ChartError,
+    ReferenceLink,
+    Setup,
+    chart_cells,
+    chart_setup,
+    chart_spec,
+)
+from ballcage.studies.sweep_run import SweepResult, pending_cases, sweep
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
 __all__ = [
@@ -65,7 +75,6 @@ __all__ = [
     "DesignChart",
     "ReferenceLink",
     "chart_table",
-    "command",
     "describe",
     "design_chart",
 ]
@@ -80,22 +89,6 @@ DEFAULT_DURATION = 1.8
 #: Wall seconds per simulated second of one case on one core of this project's 2-core AMD EPYC
 #: (2026-11-23, the default chart's cells run two at a time), for the estimate printed before a chart runs.
 SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 11.4, "ideal-cv": 1.6}
-#: Constraint keys of `Cell.broken` and their labels.
-CONSTRAINTS: dict[str, str] = {"eq9": "eq. (9)", "articulation": "articulation limit"}
-
-RADIUS, LENGTH, MASS, INERTIA = "borehole.curvature_radius", "pipe.pitch", "pipe.link_mass", "pipe.link_inertia"
-#: Scene keys the chart sets itself, and the argument that sets each; an override of one is refused.
-_CHART_KEYS: dict[str, str] = {
-    RADIUS: "`radii`, --radius-mm",
-    LENGTH: "`lengths`, --length-mm",
-    "borehole.inner_diameter": "`tube_inner_diameter`, --tube-id",
-    "pipe.link_diameter": "`joint_diameter`, --joint-od",
-    "pipe.hinge": "`hinge`, --hinge",
-    "simulation.duration": "`duration`, --duration",
-    "record.summary_window": "`window`, --window",
-}
-#: Where the base scene is checked: a bend so wide that every joint of the grid fits it [m].
-_WIDE_RADIUS = 1e3
 #: The quantities the chart table copies from the sweep's summary, in order.
 QUANTITY_COLUMNS: tuple[str, ...] = (
     "key_peak_n",
@@ -106,80 +99,6 @@ QUANTITY_COLUMNS: tuple[str, ...] = (
     "wall_time_s",
     "case_wall_time_s",
 )
-
-
-class ChartError(SweepError):
-    """Bad input to a design chart; the message names the argument, the value and the reason."""
-
-
-@dataclass(frozen=True)
-class ReferenceLink:
-    """The link masses scale from: length [m], mass [kg], inertia (axial, transverse, transverse) [kg·m²], radius [m]."""
-
-    length: float
-    mass: float
-    inertia: tuple[float, ...]
-    radius: float
-
-    @classmethod
-    def of(cls, scene: _native.Scene) -> ReferenceLink:
-        """The link of a drill-pipe scene: ``pipe.pitch``, ``pipe.link_mass``, ``pipe.link_inertia``, ``pipe.link_diameter`` / 2."""
-        inertia = tuple(float(v) for v in scene.value(INERTIA))
-        return cls(float(scene.value(LENGTH)), float(scene.value(MASS)), inertia, float(scene.value("pipe.link_diameter")) / 2)
-
-    def scaled(self, length: float) -> tuple[float, list[float]]:
-        """Mass [kg] and inertia [kg·m²] of a link `length` [m] long (the module docstring's rule).
-
-        m = m₀·L/L₀; axial I_a = I_a0·m/m₀; transverse I_t = I_t0·m(3r₀² + L²) / (m₀(3r₀² + L₀²)).
-        At L = L₀ it returns the reference's own values exactly.
-        """
-        ratio = length / self.length
-        shape = (3 * self.radius**2 + length**2) / (3 * self.radius**2 + self.length**2)
-        axial, *transverse = self.inertia
-        return self.mass * ratio, [axial * ratio, *(t * ratio * shape for t in transverse)]
-
-
-@dataclass(frozen=True)
-class Cell:
-    """One cell of the chart: R [m], L [m], its scene overrides, the constraints it breaks, the validator's refusal."""
-
-    radius: float
-    length: float
-    values: dict[str, Any]
-    broken: tuple[str, ...]  # keys of CONSTRAINTS
-    refusal: str | None  # the SceneError message; None when the scene is valid
-
-    @property
-    def feasible(self) -> bool:
-        return self.refusal is None
-
-    @property
-    def reason(self) -> str | None:
-        """Why the cell is infeasible: ``"eq. (9)"``, ``"articulation limit"``, both, or the validator's message."""
-        if self.refusal is None:
-            return None
-        return " and ".join(CONSTRAINTS[b] for b in self.broken) or f"scene refused: {self.refusal}"
-
-
-@dataclass(frozen=True)
-class _Setup:
-    """What every cell shares: the base scene text, the chart's fixed keys, the link and the limits."""
-
-    base_toml: str
-    fixed: dict[str, Any]
-    link: ReferenceLink
-    scale_mass: bool
-    limit_deg: float | None  # the hinge's articulation limit; None when nothing limits the bend
-    joints: int
-    overrides: tuple[str, ...]
-
-    @property
-    def tube(self) -> float:
-        return float(self.fixed["borehole.inner_diameter"])
-
-    @property
-    def joint(self) -> float:
-        return float(self.fixed["pipe.link_diameter"])
 
 
 @dataclass
@@ -232,21 +151,21 @@ def design_chart(
     (a `SweepError`) for bad input, before anything runs.
     """
     start = time.perf_counter()
-    setup = _setup(radii, lengths, tube_inner_diameter, joint_diameter, hinge, duration, window, scale_mass, overrides)
+    setup = chart_setup(radii, lengths, tube_inner_diameter, joint_diameter, hinge, duration, window, scale_mass, overrides)
     folder = Path(out)
     if folder.exists() and not folder.is_dir():
         raise ChartError(f"out = {str(folder)!r}: exists and is not a directory")
-    cells = _cells(setup, [float(r) for r in radii], [float(v) for v in lengths])
+    cells = chart_cells(setup, [float(r) for r in radii], [float(v) for v in lengths])
     feasible = [c for c in cells if c.feasible]
     say = (lambda text: print(f"ballcage: {text}", file=sys.stderr, flush=True)) if progress is not False else None
     result, estimate = None, None
     if feasible:
-        spec = _spec(setup, [c.values for c in feasible])
+        spec = chart_spec(setup, [c.values for c in feasible])
         pending = pending_cases(spec, folder)
         estimate = _estimate(pending, setup, workers, client)
         if say:
             say(_plan(cells, pending, estimate, setup))
-        result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress)
+        result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress, quantities=DRILL_PIPE)
     elif say:
         say(_plan(cells, 0, None, setup))
     folder.mkdir(parents=True, exist_ok=True)
@@ -255,115 +174,7 @@ def design_chart(
     return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start)
 
 
-def _setup(
-    radii: Sequence[float],
-    lengths: Sequence[float],
-    tube: float | None,
-    joint: float | None,
-    hinge: str,
-    duration: float,
-    window: tuple[float, float] | None,
-    scale_mass: bool,
-    overrides: Sequence[str],
-) -> _Setup:
-    """Checks the arguments and the base scene; raises `ChartError` naming the argument."""
-    for name, values in (("radii", radii), ("lengths", lengths)):
-        if len(values) == 0:
-            raise ChartError(f"{name}: empty; give at least one length in metres")
-        for v in values:
-            _positive(name, v, "m")
-    duration = _positive("duration", duration, "s")
-    start, end = (duration / 2, duration) if window is None else (float(window[0]), float(window[1]))
-    if not (0 <= start < end <= duration):
-        raise ChartError(f"window (--window) = ({start:g}, {end:g}) s: must satisfy 0 <= start < end <= duration = {duration:g} s")
-    for text in overrides:
-        key = text.partition("=")[0].strip()
-        if key in _CHART_KEYS:
-            raise ChartError(f"override {text!r}: the chart sets `{key}` itself (use {_CHART_KEYS[key]})")
-    base = _scene(default_scene_toml(), [*overrides, f"{RADIUS}={_WIDE_RADIUS!r}"], "overrides (--set)")
-    tube = _positive("tube_inner_diameter", tube, "m") if tube is not None else float(base.value("borehole.inner_diameter"))
-    joint = _positive("joint_diameter", joint, "m") if joint is not None else float(base.value("pipe.link_diameter"))
-    if joint >= tube:
-        raise ChartError(f"joint_diameter = {joint:g} m: not narrower than the tube, tube_inner_diameter = {tube:g} m")
-    fixed = {
-        "borehole.inner_diameter": tube,
-        "pipe.link_diameter": joint,
-        "pipe.hinge": hinge,
-        "simulation.duration": duration,
-        "record.summary_window": [start, end],
-    }
-    shared = _scene(base.to_toml(), [f"{k}={toml_value(v)}" for k, v in fixed.items()], "hinge, diameters or duration")
-    return _Setup(
-        base.to_toml(), fixed, ReferenceLink.of(base), scale_mass, shared.articulation_limit_deg(),
-        int(shared.value("pipe.joints")), tuple(overrides),
-    )
-
-
-def _positive(name: str, value: Any, unit: str) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ChartError(f"{name} = {value!r}: not a number in {unit}") from None
-    if not (math.isfinite(number) and number > 0):
-        raise ChartError(f"{name} = {value!r} {unit}: must be positive and finite")
-    return number
-
-
-def _scene(text: str, overrides: list[str], what: str) -> _native.Scene:
-    try:
-        scene = _native.Scene.from_toml(text, overrides)
-    except _native.SceneError as e:
-        raise ChartError(f"{what}: {e}") from None
-    if scene.kind != "drill-pipe":
-        raise ChartError(f"{what}: the chart needs a drill-pipe scene, not a {scene.kind} one")
-    return scene
-
-
-def _cells(setup: _Setup, radii: list[float], lengths: list[float]) -> list[Cell]:
-    """Every cell, L slowest then R, each validated by the scene validator exactly as its sweep case would run."""
-    spec = _spec(setup, [_values(setup, r, length) for length in lengths for r in radii])
-    cells = []
-    for case in spec.cases():
-        radius, length = case.values[RADIUS], case.values[LENGTH]
-        try:
-            _native.Scene.from_toml(spec.base_toml, list(case.overrides))
-            refusal = None
-        except _native.SceneError as e:
-            refusal = str(e)
-        cells.append(Cell(radius, length, case.values, _broken(setup, radius, length), refusal))
-    return cells
-
-
-def _values(setup: _Setup, radius: float, length: float) -> dict[str, Any]:
-    values: dict[str, Any] = {RADIUS: radius, LENGTH: length}
-    if setup.scale_mass:
-        values[MASS], values[INERTIA] = setup.link.scaled(length)
-    return values
-
-
-def _broken(setup: _Setup, radius: float, length: float) -> tuple[str, ...]:
-    """The constraints a cell breaks, by the closed forms (eq. (9); the articulation limit on chains of 2+ links)."""
-    out = []
-    if radius < setup.tube / 2 or length > sizing.longest_joint(radius, setup.tube, setup.joint):
-        out.append("eq9")
-    if setup.limit_deg is not None and setup.joints >= 2:
-        if radius < sizing.smallest_curvature_radius_for_bend(length, setup.limit_deg):
-            out.append("articulation")
-    return tuple(out)
-
-
-def _spec(setup: _Setup, cases: list[dict[str, Any]]) -> SweepSpec:
-    return SweepSpec(
-        name="design-chart",
-        base_toml=setup.base_toml,
-        tables=list(DEFAULT_TABLES),
-        fixed=dict(setup.fixed),
-        listed=cases,
-        source="design chart",
-    )
-
-
-def _estimate(pending: int, setup: _Setup, workers: int | None, client: Any) -> float:
+def _estimate(pending: int, setup: Setup, workers: int | None, client: Any) -> float:
     """Seconds the pending cases should take: rounds of `workers` cases at the measured cost per simulated second."""
     if client is not None:
         info: dict[str, Any] = client.scheduler_info() if hasattr(client, "scheduler_info") else {}
@@ -374,7 +185,7 @@ def _estimate(pending: int, setup: _Setup, workers: int | None, client: Any) -> 
     return math.ceil(pending / max(1, min(parallel, pending or 1))) * per_case
 
 
-def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: _Setup) -> str:
+def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: Setup) -> str:
     """The line printed before the chart runs: cells, why some are excluded, the estimate."""
     excluded: dict[str, int] = {}
     for c in cells:
@@ -397,7 +208,7 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.0f} s" if seconds < 120 else f"{int(seconds // 60)} min {seconds % 60:.0f} s"
 
 
-def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: _Setup) -> pa.Table:
+def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup) -> pa.Table:
     """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities.
 
     Units and descriptions in each field's metadata (and as JSON in the file's), like ``summary.parquet``.
@@ -418,7 +229,7 @@ def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: _Setup) 
     return pa.Table.from_arrays(arrays, schema=schema)
 
 
-def _row(cell: Cell, case: Mapping[str, Any] | None, setup: _Setup) -> dict[str, Any]:
+def _row(cell: Cell, case: Mapping[str, Any] | None, setup: Setup) -> dict[str, Any]:
     mass, inertia = setup.link.scaled(cell.length) if setup.scale_mass else (setup.link.mass, list(setup.link.inertia))
     ratio = cell.length / (2 * cell.radius)
     fits = cell.radius >= setup.tube / 2
@@ -431,9 +242,9 @@ def _row(cell: Cell, case: Mapping[str, Any] | None, setup: _Setup) -> dict[str,
         "excluded_by_eq9": "eq9" in cell.broken,
         "excluded_by_articulation": "articulation" in cell.broken,
         "hinge_bend_deg": math.degrees(2 * math.asin(ratio)) if ratio <= 1 else None,
-        "longest_joint_m": sizing.longest_joint(cell.radius, setup.tube, setup.joint) if fits else None,
+        "longest_joint_m": sizing.longest_link(cell.radius, setup.tube, setup.joint) if fits else None,
         "tightest_radius_for_bend_m": (
-            sizing.smallest_curvature_radius_for_bend(cell.length, setup.limit_deg) if setup.limit_deg else None
+            sizing.tightest_radius_for_bend(cell.length, setup.limit_deg) if setup.limit_deg else None
         ),
         MASS: mass,
         "link_inertia_axial": inertia[0],
@@ -475,7 +286,7 @@ def _columns() -> dict[str, tuple[pa.DataType, str, str]]:
     return columns
 
 
-def _file_metadata(fields: list[pa.Field], setup: _Setup) -> dict[str, str]:
+def _file_metadata(fields: list[pa.Field], setup: Setup) -> dict[str, str]:
     window = setup.fixed["record.summary_window"]
     return {
         "ballcage.version": _native.__version__,
@@ -517,29 +328,3 @@ def describe(chart: DesignChart) -> Iterable[str]:
             f"ballcage: {chart.sweep.ran} cases run, {chart.sweep.skipped} skipped (already finished), "
             f"{chart.failed} not ok; {_duration(chart.elapsed_s)} in all{guess}"
         )
-
-
-def command(args: Any, **inputs: Any) -> int:
-    """``ballcage chart`` after the CLI has checked and converted its options (`inputs`, SI, for `design_chart`).
-
-    Prints the estimate before and the files after; 0 when every feasible cell finished, 1 when some did not.
-    """
-    try:
-        with scheduler_client(args.scheduler) as client:
-            chart = design_chart(
-                args.out, **inputs, overrides=args.overrides, workers=args.workers, client=client,
-                progress=False if args.quiet else None,
-            )
-    except KeyboardInterrupt:
-        print(f"ballcage: chart interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
-        raise
-    if not args.quiet:
-        for line in describe(chart):
-            print(line)
-    if chart.failed:
-        bad = [r for r in chart.table.to_pylist() if r["feasible"] and r["status"] != "ok"]
-        where = f"R = {bad[0][RADIUS]:g} m, L = {bad[0][LENGTH]:g} m: {bad[0]['status']}" if bad else "see summary.parquet"
-        print(f"ballcage: error: {chart.failed} feasible cells did not finish (first {where}); "
-              f"see {chart.out / 'summary.parquet'}", file=sys.stderr)
-        return 1
-    return 0

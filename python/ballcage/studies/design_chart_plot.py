@@ -118,12 +118,12 @@ def _boundaries(ax: Axes, meta: dict[str, str], radii: list[float], lengths: lis
     tube = float(meta["ballcage.chart_tube_inner_diameter_m"])
     joint = float(meta["ballcage.chart_joint_diameter_m"])
     r = np.linspace(max(xe[0], tube / 2), xe[-1], 300)
-    ax.plot(r, [sizing.longest_joint(float(x), tube, joint) for x in r], color="tab:red", lw=2,
+    ax.plot(r, [sizing.longest_link(float(x), tube, joint) for x in r], color="tab:red", lw=2,
             label=f"eq. (9): longest joint that fits, D = {1e3 * tube:g} mm, d = {1e3 * joint:g} mm")
     limit = json.loads(meta.get("ballcage.chart_articulation_limit_deg", "null"))
     if limit is not None and int(meta.get("ballcage.chart_joints", "2")) >= 2:
         length = np.linspace(max(ye[0], 1e-6), ye[-1], 300)
-        ax.plot([sizing.smallest_curvature_radius_for_bend(float(v), limit) for v in length], length, color="black",
+        ax.plot([sizing.tightest_radius_for_bend(float(v), limit) for v in length], length, color="black",
                 ls="--", lw=2, label=f"articulation limit {limit:.2f}°: R = L / (2 sin(β/2))")
     if math.isclose(tube, sizing.PAPER_TUBE_INNER_DIAMETER) and math.isclose(joint, sizing.PAPER_JOINT_OUTER_DIAMETER):
         ax.plot([1.5], [0.2], marker="o", mfc="none", mec="tab:orange", mew=2.5, ms=30, ls="none",

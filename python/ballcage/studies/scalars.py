@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 import pyarrow as pa
 
-from ballcage import _native
 from ballcage._links import link_tube_forces
 from ballcage.run import Run
 
@@ -125,7 +124,8 @@ def _body_quantities(run: Run) -> dict[str, Quantity]:
     bodies = _recorded(run, "bodies")
     if bodies is None:
         return {}
-    integrated = _integrated_bodies(run.scene)
+    # a generic scene's quantities are its moving bodies' (`Scene.integrated_bodies`); a drill pipe's, every recorded body's
+    integrated = set(run.scene.integrated_bodies) if run.scene.kind == "generic" else None
     last = last_frame(bodies)
     names = last.column("body").cast(pa.string()).to_pylist()
     cols = {c: last.column(c).to_numpy() for c in last.column_names if c.startswith(("pos_", "vel_", "angvel_"))}
@@ -159,13 +159,6 @@ def last_frame(table: pa.Table) -> pa.Table:
     import pyarrow.compute as pc
 
     return table.filter(pc.equal(table.column("step"), pc.max(table.column("step"))))
-
-
-def _integrated_bodies(scene: _native.Scene) -> set[str] | None:
-    """Names of the bodies the integrator moves (``dynamic`` and ``spin``); ``None`` for a drill pipe (all)."""
-    if scene.kind != "generic":
-        return None
-    return {b["name"] for b in scene.value("bodies") if b.get("motion", "dynamic") in ("dynamic", "spin")}
 
 
 def relative_error(q: Quantity, ref: Quantity, floor: float) -> float:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
@@ -29,7 +28,8 @@ class Parameter:
 
 #: Built-in drill-pipe parameters, in the order they are studied.
 PARAMETER_NAMES: tuple[str, ...] = ("stiffness", "speed", "curvature_radius", "key_mass", "damping")
-#: Range of the built-in parameters (paper units where the scene's law uses them).
+#: Range of the built-in parameters; the contact law's in the paper's N-mm-s units, set in the law's own
+#: units (`ballcage.Scene.scale_from`).
 STIFFNESS_RANGE = (1e3, 1e7)  # N/mm^n
 SPEED_RANGE = (30.0, 600.0)  # rpm
 LARGEST_RADIUS = 5.0  # m
@@ -73,13 +73,8 @@ def drill_pipe_parameters(scene: SceneSource | None = None, values_per_parameter
     if resolved.kind != "drill-pipe":
         raise InputError(f"scene kind = {resolved.kind!r}: the built-in stability parameters need a drill-pipe scene")
     n = values_per_parameter
-    law: dict[str, Any] = resolved.value("materials.internal.normal")
-    exponent = float(law.get("exponent", 1.0))
-    paper_units = law.get("units") == "N-mm-s"
-    k_scale = 1.0 if paper_units else 1000.0**exponent
-    c_scale = 1.0 if paper_units else 1000.0
-    k_unit = f"N/mm^{exponent:g}" if paper_units else f"N/m^{exponent:g}"
-    c_unit = "N·s/mm" if paper_units else "N·s/m"
+    k_key, c_key = "materials.internal.normal.stiffness", "materials.internal.normal.damping"
+    (k_scale, k_unit), (c_scale, c_unit) = _in_law_units(resolved, k_key), _in_law_units(resolved, c_key)
     mass = float(resolved.value("pipe.ball_keys.ball_mass"))
 
     def geom(lo: float, hi: float, count: int) -> tuple[float, ...]:
@@ -88,34 +83,46 @@ def drill_pipe_parameters(scene: SceneSource | None = None, values_per_parameter
     return {
         "stiffness": Parameter(
             "stiffness",
-            ("materials.internal.normal.stiffness",),
+            (k_key,),
             tuple(v * k_scale for v in geom(*STIFFNESS_RANGE, n)),
             k_unit,
             "K of the internal (key, cage) contacts",
         ),
-        "speed": Parameter("speed", ("drive.speed_rpm",), geom(*SPEED_RANGE, n), "rpm", "drive speed"),
+        "speed": Parameter(
+            "speed", ("drive.speed_rpm",), geom(*SPEED_RANGE, n), resolved.unit("drive.speed_rpm"), "drive speed"
+        ),
         "curvature_radius": Parameter(
             "curvature_radius",
             ("borehole.curvature_radius",),
             geom(tightest_radius(resolved), LARGEST_RADIUS, n),
-            "m",
+            resolved.unit("borehole.curvature_radius"),
             "guide tube curvature radius, from the tightest the hinge allows",
         ),
         "key_mass": Parameter(
             "key_mass",
             ("pipe.ball_keys.ball_mass",),
             geom(mass * KEY_MASS_FACTORS[0], mass * KEY_MASS_FACTORS[1], n),
-            "kg",
+            resolved.unit("pipe.ball_keys.ball_mass"),
             "ball key mass",
         ),
         "damping": Parameter(
             "damping",
-            ("materials.internal.normal.damping",),
+            (c_key,),
             (0.0, *(v * c_scale for v in geom(*DAMPING_RANGE, n - 1))),
             c_unit,
             "damping of the internal contacts (IMPACT c_max)",
         ),
     }
+
+
+def _in_law_units(scene: _native.Scene, key: str) -> tuple[float, str]:
+    """The factor from the paper's N-mm-s units to the units `scene`'s contact law writes `key` in, and
+    that unit, both from the engine; ``(1.0, "")`` when the law has no such field (setting it fails
+    then, naming it)."""
+    try:
+        return scene.scale_from(key, "N-mm-s"), scene.unit(key)
+    except InputError:
+        return 1.0, ""
 
 
 #: The default probe scene: the paper's drill pipe, shortened (see `probe_scene`).

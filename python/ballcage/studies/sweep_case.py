@@ -4,8 +4,9 @@
 the sweep's output folder (on Dask, a filesystem every worker and the client
 share): ``DIR/<table>/case=NNNN/part.parquet`` for each recorded table, then
 ``DIR/cases/case=NNNN.scene.toml`` and, last, the case's record
-``DIR/cases/case=NNNN.json`` (`CaseRecord` fields: status, error, swept
-values, engine cost, derived quantities). Every file is written to a
+``DIR/cases/case=NNNN.json`` (a JSON object: status, error, swept values,
+engine cost, and the quantities of the task's plug-in,
+`ballcage.studies.sweep_quantities.SweepQuantities`). Every file is written to a
 temporary name and renamed, so a file under its final name is complete, and a
 case with a record is finished. A run that diverges keeps what it recorded up
 to then (status ``diverged``); any other failure is status ``error``; neither
@@ -25,7 +26,7 @@ from typing import Any
 from ballcage import _native
 from ballcage._files import write_parquet, write_text
 from ballcage.run import Run, simulate
-from ballcage.studies.sweep_quantities import case_quantities
+from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
 from ballcage.studies.sweep_spec import partition_name
 
 __all__ = ["CaseTask", "read_case_run", "read_record", "record_path", "run_case", "scene_path", "write_record"]
@@ -49,6 +50,7 @@ class CaseTask:
     values: dict[str, Any]  # swept key -> value as written
     parameters: tuple[str, ...]  # every swept key of the sweep, for the resolved values
     out: str  # the sweep's output folder
+    quantities: SweepQuantities = GENERIC  # what the record's "quantities" hold (pickled with the task)
 
 
 def record_path(out: Path, partition: str) -> Path:
@@ -78,7 +80,7 @@ def run_case(task: CaseTask) -> dict[str, Any]:
         if run is not None:
             record["tables"] = _write_tables(run, out, task.partition)
             record.update(_cost(run))
-            record["quantities"] = case_quantities(run)
+            record["quantities"] = task.quantities(run)
     except Exception as e:  # noqa: BLE001
         record["status"], record["error"] = "error", _join(error, f"after the run: {_describe(e)}")
     path = scene_path(out, task.partition)

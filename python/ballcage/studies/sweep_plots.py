@@ -68,7 +68,7 @@ def _figure(rows: list[dict[str, Any]], parameter: str, others: list[str], names
                 ((float(r[parameter]) if numeric else order.index(_key(r[parameter])), r[name]) for r in members if _number(r[name])),
             )
             if points:
-                text = ", ".join(f"{o}={v}" for o, v in zip(others, label, strict=True)) or None
+                text = ", ".join(_setting(o, v, units) for o, v in zip(others, label, strict=True)) or None
                 ax.plot([p[0] for p in points], [p[1] for p in points], label=text, **style)
         if not numeric:
             ax.set_xticks(range(len(order)), order, rotation=20)
@@ -94,8 +94,17 @@ def _key(value: Any) -> str:
 
 
 def _label(name: str, units: dict[str, str]) -> str:
+    """An axis label with its unit: ``[-]`` for a pure number (unit ``1`` or ``-``), none for a text column."""
     unit = units.get(name, "")
-    return f"{name} [{unit}]" if unit and unit != "1" else name
+    if unit in ("1", "-"):
+        unit = "-"
+    return f"{name} [{unit}]" if unit else name
+
+
+def _setting(parameter: str, value: str, units: dict[str, str]) -> str:
+    """A legend entry's ``parameter=value unit`` (no unit for a pure number or a text value)."""
+    unit = units.get(parameter, "")
+    return f"{parameter}={value} {unit}" if unit not in ("", "1", "-") else f"{parameter}={value}"
 
 
 def _file_name(parameter: str) -> str:

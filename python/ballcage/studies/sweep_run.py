@@ -8,6 +8,10 @@ Output folder (docs/studies.md)::
     DIR/cases/case=NNNN.scene.toml           the case's resolved scene
     DIR/plots/<parameter>.png                each quantity against each swept parameter
 
+Each case's quantities (``summary.parquet``'s columns after the swept keys)
+come from a plug-in, `ballcage.studies.sweep_quantities.SweepQuantities`:
+by default the one of the base scene's kind (`for_scene`).
+
 Running the same sweep into the same folder again resumes: a case with a
 record whose hash matches and whose table files exist is skipped (with
 ``retry_failed``, only if it finished ``ok``). A record of another sweep's
@@ -29,10 +33,12 @@ from typing import Any, TextIO
 
 import pyarrow as pa
 
+from ballcage import _native
 from ballcage._files import write_parquet
 from ballcage.run import _isatty
 from ballcage.studies.sweep_case import CaseTask, failed_record, read_record, run_case, table_path, write_record
 from ballcage.studies.sweep_plots import write_plots
+from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities, for_scene
 from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
@@ -60,6 +66,7 @@ def sweep(
     retry_failed: bool = False,
     plots: bool = True,
     progress: bool | None = None,
+    quantities: SweepQuantities | None = None,
 ) -> SweepResult:
     """Runs every case of a sweep file (path, dict or `SweepSpec`) into the folder `out`.
 
@@ -70,15 +77,21 @@ def sweep(
     every worker and this process see (a shared filesystem). A case that
     diverges or fails is recorded (``status``, ``error``, its partial tables)
     and the others go on. `progress`: ``None`` a bar on a terminal and a line
-    per case otherwise, ``False`` silent. Raises `SweepError` for a bad sweep
-    file or a folder holding another sweep, before anything runs.
+    per case otherwise, ``False`` silent. `quantities`: what each case's
+    record and the summary's quantity columns hold (a `SweepQuantities`
+    plug-in; ``None``: `for_scene` of the base scene, so the drill pipe's
+    quantities for a drill pipe and none for a scene of bodies). Raises
+    `SweepError` for a bad sweep file or a folder holding another sweep,
+    before anything runs.
     """
     loaded = load_sweep(spec)
     cases = loaded.check()
     folder = Path(out)
     if folder.exists() and not folder.is_dir():
         raise SweepError(f"--out {folder}: exists and is not a directory")
-    tasks = [_task(loaded, c, folder) for c in cases]
+    base = _native.Scene.from_toml(loaded.base_toml)
+    plugin = quantities if quantities is not None else for_scene(base)
+    tasks = [_task(loaded, c, folder, plugin) for c in cases]
     pending, done = _split_finished(tasks, folder, retry_failed)
     say = _Say(progress is not False)
     where = _where(client, workers)
@@ -90,7 +103,7 @@ def sweep(
         records = done + (_run_dask(client, pending, bar) if client is not None else _run_local(pending, workers, bar))
     finally:
         bar.close()
-    return _finish(loaded, records, folder, len(pending), len(done), plots)
+    return _finish(loaded, base, plugin, records, folder, (len(pending), len(done)), plots)
 
 
 def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
@@ -101,7 +114,7 @@ def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
     return len(pending)
 
 
-def _task(spec: SweepSpec, case: Case, out: Path) -> CaseTask:
+def _task(spec: SweepSpec, case: Case, out: Path, quantities: SweepQuantities = GENERIC) -> CaseTask:
     return CaseTask(
         index=case.index,
         case_id=case.case_id,
@@ -112,6 +125,7 @@ def _task(spec: SweepSpec, case: Case, out: Path) -> CaseTask:
         values=case.values,
         parameters=tuple(spec.parameters),
         out=str(out.resolve()),
+        quantities=quantities,
     )
 
 
@@ -188,22 +202,29 @@ def _result(get: Callable[[], dict[str, Any]], task: CaseTask) -> dict[str, Any]
         return record
 
 
-def _finish(spec: SweepSpec, records: list[dict[str, Any]], out: Path, ran: int, skipped: int, plots: bool) -> SweepResult:
-    from ballcage import _native
-
-    units = parameter_units(_native.Scene.from_toml(spec.base_toml).to_toml(units=True), spec.parameters)
+def _finish(
+    spec: SweepSpec,
+    base: _native.Scene,
+    quantities: SweepQuantities,
+    records: list[dict[str, Any]],
+    out: Path,
+    counts: tuple[int, int],
+    plots: bool,
+) -> SweepResult:
+    """Writes ``summary.parquet`` (and the plots) of the `records`; `counts`: cases (ran, skipped)."""
+    units = parameter_units(base, spec.parameters)
     meta = {
         "ballcage.sweep": spec.name,
         "ballcage.sweep_parameters": json.dumps(spec.parameters),
         "ballcage.sweep_fixed": json.dumps(spec.fixed),
         "ballcage.sweep_base": str(spec.base) if spec.base is not None else "embedded paper scene",
     }
-    table = summary_table(records, spec.parameters, units, meta)
+    table = summary_table(records, spec.parameters, units, meta, quantities)
     paths = {"summary": write_parquet(table, out / "summary.parquet")}
     if plots:
         paths.update({f"plot_{k}": v for k, v in write_plots(table, spec.parameters, out).items()})
     failed = sum(1 for r in records if r.get("status") != "ok")
-    return SweepResult(table, out, ran, skipped, failed, paths)
+    return SweepResult(table, out, *counts, failed, paths)
 
 
 class SweepProgress:
@@ -291,34 +312,3 @@ def scheduler_client(scheduler: str | None) -> Iterator[Any]:
         if client is not None:
             client.close()
 
-
-def command(args: Any) -> int:
-    """``ballcage sweep``: runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not."""
-    try:
-        with scheduler_client(args.scheduler) as client:
-            result = sweep(
-                args.sweep,
-                args.out,
-                client=client,
-                workers=args.workers,
-                retry_failed=args.retry_failed,
-                plots=not args.no_plots,
-                progress=False if args.quiet else None,
-            )
-    except KeyboardInterrupt:
-        print(f"ballcage: sweep interrupted; run the same command again to resume from {args.out}", file=sys.stderr)
-        raise
-    if not args.quiet:
-        for line in describe(result):
-            print(line)
-    if result.failed:
-        bad = [r for r in result.summary.to_pylist() if r["status"] != "ok"]
-        first = bad[0]
-        print(
-            f"ballcage: error: {result.failed} of {result.summary.num_rows} cases did not finish "
-            f"(case {first['case_id']} {first['status']}: {' '.join(str(first['error']).split())}); "
-            f"see {result.paths['summary']}",
-            file=sys.stderr,
-        )
-        return 1
-    return 0

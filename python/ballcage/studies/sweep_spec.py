@@ -106,9 +106,16 @@ class SweepSpec:
         doc = tomllib.loads(self.base_toml)
         if self.tables is not None:
             out.append("record.tables=" + toml_value(self.tables))
-        elif doc.get("kind") == "drill-pipe" and (self.base is None or "tables" not in doc.get("record", {})):
+        elif (self.base is None or "tables" not in doc.get("record", {})) and self._base_kind() == "drill-pipe":
             out.append("record.tables=" + toml_value(list(DEFAULT_TABLES)))
         return out
+
+    def _base_kind(self) -> str | None:
+        """The base scene's kind (`Scene.kind`); None when the base alone is not a valid scene (`check` names why)."""
+        try:
+            return _native.Scene.from_toml(self.base_toml).kind
+        except _native.SceneError:
+            return None
 
     def cases(self) -> list[Case]:
         """Every case, grid first (its first key slowest), then the listed ones."""

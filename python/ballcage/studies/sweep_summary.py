@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Mapping, Sequence
 from typing import Any
 
 import pyarrow as pa
 
 from ballcage import _native
-from ballcage.studies.sweep_quantities import QUANTITIES, link_columns
+from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
 
 __all__ = ["COST_COLUMNS", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
 
@@ -32,21 +31,18 @@ COST_COLUMNS: tuple[tuple[str, pa.DataType, str, str], ...] = (
 )
 
 
-def parameter_units(scene_toml_with_units: str, keys: Sequence[str]) -> dict[str, str]:
-    """The unit of each dotted key, read from a scene printed with ``to_toml(units=True)``; ``""`` if none."""
-    section, units = "", {}
-    lines: dict[str, str] = {}
-    for raw in scene_toml_with_units.splitlines():
-        line = raw.strip()
-        header = re.fullmatch(r"\[+([^\]]+)\]+", line)
-        if header:
-            section = header.group(1).strip()
-            continue
-        m = re.match(r"([A-Za-z0-9_\-]+)\s*=.*#\s*(.+)$", line)
-        if m:
-            lines[f"{section}.{m.group(1)}" if section else m.group(1)] = m.group(2).strip()
+def parameter_units(scene: _native.Scene, keys: Sequence[str]) -> dict[str, str]:
+    """The unit of each dotted key of `scene`, from the engine's table of field units (`Scene.unit`).
+
+    ``""`` for a pure number, text, or a key `scene` does not have (a sweep may set
+    one its base scene leaves out).
+    """
+    units: dict[str, str] = {}
     for key in keys:
-        unit = lines.get(key, "")
+        try:
+            unit = scene.unit(key)
+        except _native.InputError:
+            unit = ""
         units[key] = "" if unit == "-" else unit
     return units
 
@@ -56,8 +52,9 @@ def summary_table(
     parameters: Sequence[str],
     units: Mapping[str, str],
     meta: Mapping[str, str],
+    quantities: SweepQuantities = GENERIC,
 ) -> pa.Table:
-    """One row per record (sorted by case): head, swept parameters, derived quantities, cost."""
+    """One row per record (sorted by case): head, swept parameters, the `quantities` plug-in's columns, cost."""
     rows = sorted(records, key=lambda r: int(r["case"]))
     fields: list[pa.Field] = []
     arrays: list[pa.Array] = []
@@ -71,7 +68,7 @@ def summary_table(
         add(name, [r.get(name) for r in rows], kind, unit, description)
     for key in parameters:
         add(key, [r.get("parameters", {}).get(key) for r in rows], None, units.get(key, ""), f"scene key {key} (swept)")
-    for name, (unit, description) in _quantity_columns(rows).items():
+    for name, (unit, description) in _quantity_columns(rows, quantities).items():
         add(name, [r.get("quantities", {}).get(name) for r in rows], pa.float64(), unit, description)
     for name, kind, unit, description in COST_COLUMNS:
         add(name, [r.get(name) for r in rows], kind, unit, description)
@@ -83,16 +80,10 @@ def summary_table(
     return pa.Table.from_arrays(arrays, schema=schema.with_metadata(file_meta))
 
 
-def _quantity_columns(rows: Sequence[Mapping[str, Any]]) -> dict[str, tuple[str, str]]:
-    """The fixed quantity columns, when any case is a drill pipe, then the per-link ones of the most links."""
+def _quantity_columns(rows: Sequence[Mapping[str, Any]], quantities: SweepQuantities) -> dict[str, tuple[str, str]]:
+    """The plug-in's columns when any case recorded a quantity (none otherwise)."""
     present = {k for r in rows for k in r.get("quantities", {})}
-    if not present:
-        return {}
-    out = dict(QUANTITIES)
-    links = sorted({int(m.group(1)) for k in present if (m := re.fullmatch(r"tube_normal_mean_link_(\d+)_n", k))})
-    for link in links:
-        out.update(link_columns(link))
-    return out
+    return quantities.columns(present) if present else {}
 
 
 def _array(values: list[Any], kind: pa.DataType | None) -> pa.Array:

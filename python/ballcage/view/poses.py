@@ -7,7 +7,8 @@ the spin); otherwise from the ``links`` table (``com_*`` and the eq. (4)
 angles: the axis, but not the spin). Ball keys are drawn where the ``bodies``
 table holds their poses (a scene recording them in ``record.bodies``); the
 bodies are then drawn a cage length shorter at each hinge, so that the keys
-inside the joints show. The
+inside the joints show. Bodies are told apart by the ``bodies`` table's part
+ids (``part``, ``link``, ``hinge``, ``key``), never by their names. The
 geometry is the run's own scene (``scene.toml``), and the tube's centreline
 is the native module's (`ballcage.Scene.centreline`). Everything is SI (m, s, N).
 """
@@ -16,7 +17,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -32,13 +32,11 @@ __all__ = ["ChainFrames", "TubeShape", "chain_frames", "read_run", "tube_shape"]
 
 #: Columns the view reads from each table it uses.
 _COLUMNS: dict[str, tuple[str, ...]] = {
-    "bodies": ("t", "body", "pos_x", "pos_y", "pos_z", "quat_w", "quat_x", "quat_y", "quat_z"),
-    "links": ("t", "link", "body", "com_x", "com_y", "com_z", "inclination_deg", "azimuth_deg", "tube_normal"),
+    "bodies": ("t", "part", "link", "hinge", "key", "pos_x", "pos_y", "pos_z", "quat_w", "quat_x", "quat_y", "quat_z"),
+    "links": ("t", "link", "com_x", "com_y", "com_z", "inclination_deg", "azimuth_deg", "tube_normal"),
 }
-#: The connectors' body names (crates/ballcage-core/src/drillpipe/names.rs, `UPPER` and `LOWER`).
-UPPER, LOWER = "upper", "lower"
-#: A ball key's body name, ``h<hinge, 2 digits>.key<j>`` (names.rs, `names::key`): keys have no id column in `bodies`.
-_KEY_NAME = re.compile(r"h\d{2,}\.key\d+")
+#: ``bodies.part`` labels of the connectors, links and ball keys (crates/ballcage-core/src/drillpipe/layout.rs, `Part::LABELS`).
+UPPER, LOWER, LINK, KEY = "upper", "lower", "link", "key"
 #: Two frame times closer than this [s] are the same frame.
 _TIME_TOLERANCE = 1e-9
 #: Spacing [m] of the centreline samples that the tube is drawn through.
@@ -111,6 +109,11 @@ def read_run(directory: str | os.PathLike[str]) -> Run:
 
 
 def _read_tables(path: Path) -> dict[str, pa.Table]:
+    """The tables the view uses that `path` holds.
+
+    A ``bodies.parquet`` without the part ids (written before they were recorded) is left out: the view then draws
+    from the ``links`` table.
+    """
     import pyarrow.parquet as pq  # deferred: only readers pay for it
 
     tables: dict[str, pa.Table] = {}
@@ -119,6 +122,8 @@ def _read_tables(path: Path) -> dict[str, pa.Table]:
         if not file.exists():
             continue
         try:
+            if name == "bodies" and not set(columns) <= set(pq.read_schema(file).names):
+                continue
             tables[name] = pq.read_table(file, columns=list(columns))
         except (pa.ArrowException, OSError) as e:
             raise InputError(f"{file}: cannot read the columns {', '.join(columns)}: {e}") from e
@@ -139,11 +144,11 @@ def chain_frames(run: Run, max_frames: int = 120) -> ChainFrames:
         raise InputError(f"scene kind = {scene.kind!r}: the view draws drill-pipe runs only")
     links = _nonempty(run.tables.get("links"))
     bodies = _nonempty(run.tables.get("bodies"))
-    names = _link_bodies(links, int(scene.value("pipe.joints")))
-    if bodies is not None and set(names) <= set(_strings(bodies, "body")):
-        return _from_bodies(run, bodies, links, names, max_frames)
+    joints = int(scene.value("pipe.joints"))
+    if bodies is not None and set(range(1, joints + 1)) <= set(_chain_positions(bodies, joints)):
+        return _from_bodies(run, bodies, links, joints, max_frames)
     if links is not None:
-        return _from_links(run, links, names, max_frames)
+        return _from_links(run, links, joints, max_frames)
     raise InputError(
         "no link poses: the run recorded neither the links' bodies in the bodies table nor the links table; "
         "record them, e.g. `ballcage run --tables bodies,links`"
@@ -154,17 +159,20 @@ def _nonempty(table: pa.Table | None) -> pa.Table | None:
     return table if table is not None and table.num_rows else None
 
 
-def _link_bodies(links: pa.Table | None, joints: int) -> list[str]:
-    """The links' body names, link 1 first: from the links table's ``link`` and ``body`` columns where recorded."""
-    if links is None:
-        return [f"link{k:02}" for k in range(1, joints + 1)]  # names.rs, `chain_body`
-    by_link = dict(zip(links.column("link").to_pylist(), _strings(links, "body")))
-    return [by_link[k] for k in sorted(by_link)]
-
-
 def _strings(table: pa.Table, column: str) -> np.ndarray:
-    """A (dictionary-encoded) string column as a numpy array of str."""
+    """A (dictionary-encoded) string column as a numpy array of str (None where null)."""
     return np.asarray(pc.cast(table.column(column), pa.string()).to_pylist(), dtype=object)
+
+
+def _ids(table: pa.Table, column: str) -> np.ndarray:
+    """An id column as int64, -1 where null."""
+    return pc.cast(table.column(column), pa.int64()).fill_null(-1).to_numpy()
+
+
+def _chain_positions(bodies: pa.Table, joints: int) -> np.ndarray:
+    """Each row's chain position by its part ids: 0 the upper connector, k link k, joints + 1 the lower, else -1."""
+    part = _strings(bodies, "part")
+    return np.select([part == UPPER, part == LINK, part == LOWER], [0, _ids(bodies, "link"), joints + 1], -1)
 
 
 def _frames(times: np.ndarray, max_frames: int) -> np.ndarray:
@@ -184,38 +192,44 @@ def _grid(table: pa.Table, times: np.ndarray, ids: np.ndarray, count: int, colum
     return out
 
 
-def _index_of(names: np.ndarray, wanted: list[str]) -> np.ndarray:
-    """Position of each of `names` in `wanted`, -1 for names not wanted."""
-    position = {name: i for i, name in enumerate(wanted)}
-    return np.fromiter((position.get(n, -1) for n in names), dtype=np.int64, count=len(names))
+def _index_of(values: list[object], wanted: list[object]) -> np.ndarray:
+    """Position of each of `values` in `wanted`, -1 for values not wanted."""
+    position = {v: i for i, v in enumerate(wanted)}
+    return np.fromiter((position.get(v, -1) for v in values), dtype=np.int64, count=len(values))
 
 
-def _from_bodies(run: Run, bodies: pa.Table, links: pa.Table | None, names: list[str], max_frames: int) -> ChainFrames:
+def _key_ids(bodies: pa.Table) -> list[tuple[int, int] | None]:
+    """Each row's ``(hinge, key)`` for a ball key's row, None for other bodies."""
+    part, hinge, key = _strings(bodies, "part"), _ids(bodies, "hinge"), _ids(bodies, "key")
+    return [(int(h), int(j)) if p == KEY else None for p, h, j in zip(part, hinge, key, strict=True)]
+
+
+def _from_bodies(run: Run, bodies: pa.Table, links: pa.Table | None, joints: int, max_frames: int) -> ChainFrames:
     """The chain from the bodies table: connectors where recorded, every link, and the ball keys where recorded."""
     geometry = _Geometry.of(run.scene)
-    recorded = _strings(bodies, "body")
-    present = set(recorded)
-    chain = [n for n in (UPPER, *names, LOWER) if n in present]
+    positions = _chain_positions(bodies, joints)
+    chain = sorted({int(p) for p in positions if p >= 0})  # chain positions recorded, upper connector first
     times = _frames(np.unique(bodies.column("t").to_numpy()), max_frames)
     columns = ["pos_x", "pos_y", "pos_z", "quat_w", "quat_x", "quat_y", "quat_z"]
-    grid = _grid(bodies, times, _index_of(recorded, chain), len(chain), columns)
+    grid = _grid(bodies, times, _index_of(list(positions), list(chain)), len(chain), columns)
     whole = np.isfinite(grid).all(axis=(1, 2))  # frames where every body of the chain is recorded
     grid, times = grid[whole], times[whole]
     axes, sides = _body_axes(grid[..., 3:])
-    is_link = np.array([n not in (UPPER, LOWER) for n in chain])
+    is_link = np.array([0 < p <= joints for p in chain])
     force = np.full((len(times), len(chain)), np.nan)
     if links is not None:
         link_ids = links.column("link").to_numpy().astype(np.int64) - 1
-        force[:, is_link] = _grid(links, times, link_ids, len(names), ["tube_normal"])[..., 0]
-    key_names = sorted({n for n in present if _KEY_NAME.fullmatch(n)})
-    keys = _grid(bodies, times, _index_of(recorded, key_names), len(key_names), columns[:3]) if key_names else None
+        force[:, is_link] = _grid(links, times, link_ids, joints, ["tube_normal"])[..., 0]
+    key_rows = _key_ids(bodies)
+    key_ids: list[object] = sorted({k for k in key_rows if k is not None})
+    keys = _grid(bodies, times, _index_of(key_rows, key_ids), len(key_ids), columns[:3]) if key_ids else None
     lengths = np.where(is_link, geometry.pitch, geometry.connector_length)
     centres = grid[..., :3]
     if keys is not None:  # open the joints, so that the keys inside them show
-        centres, lengths = _open_joints(centres, axes, lengths, chain, geometry.cage_length)
+        centres, lengths = _open_joints(centres, axes, lengths, chain, joints, geometry.cage_length)
     return ChainFrames(
         times=times,
-        labels=tuple(_label(n, names) for n in chain),
+        labels=tuple(_label(p, joints) for p in chain),
         is_link=is_link,
         centres=centres,
         axes=axes,
@@ -232,27 +246,26 @@ def _from_bodies(run: Run, bodies: pa.Table, links: pa.Table | None, names: list
     )
 
 
-def _from_links(run: Run, links: pa.Table, names: list[str], max_frames: int) -> ChainFrames:
+def _from_links(run: Run, links: pa.Table, joints: int, max_frames: int) -> ChainFrames:
     """The links alone from the links table: centre of mass and the eq. (4) axis; no spin, no connectors, no keys."""
     geometry = _Geometry.of(run.scene)
     times = _frames(np.unique(links.column("t").to_numpy()), max_frames)
     ids = links.column("link").to_numpy().astype(np.int64) - 1
     columns = ["com_x", "com_y", "com_z", "inclination_deg", "azimuth_deg", "tube_normal"]
-    grid = _grid(links, times, ids, len(names), columns)
+    grid = _grid(links, times, ids, joints, columns)
     whole = np.isfinite(grid[..., :5]).all(axis=(1, 2))
     grid, times = grid[whole], times[whole]
     phi, theta = np.radians(grid[..., 3]), np.radians(grid[..., 4])
     axes = np.stack([np.sin(phi) * np.cos(theta), np.sin(phi) * np.sin(theta), -np.cos(phi)], axis=-1)
-    n = len(names)
     return ChainFrames(
         times=times,
-        labels=tuple(_label(name, names) for name in names),
-        is_link=np.ones(n, dtype=bool),
+        labels=tuple(_label(k, joints) for k in range(1, joints + 1)),
+        is_link=np.ones(joints, dtype=bool),
         centres=grid[..., :3],
         axes=axes,
         sides=None,
-        radii=np.full(n, geometry.link_radius),
-        lengths=np.full(n, geometry.pitch),
+        radii=np.full(joints, geometry.link_radius),
+        lengths=np.full(joints, geometry.pitch),
         tube_force=grid[..., 5],
         keys=None,
         key_radius=geometry.key_radius,
@@ -264,29 +277,31 @@ def _from_links(run: Run, links: pa.Table, names: list[str], max_frames: int) ->
 
 
 def _open_joints(
-    centres: np.ndarray, axes: np.ndarray, lengths: np.ndarray, chain: list[str], gap: float
+    centres: np.ndarray, axes: np.ndarray, lengths: np.ndarray, chain: list[int], joints: int, gap: float
 ) -> tuple[np.ndarray, np.ndarray]:
     """Bodies drawn `gap` [m] shorter at each hinge: links at both ends, connectors at their hinge end only.
 
-    The upper connector's hinge is at its + end (its axis points down the tube), the lower one's at its − end.
+    `chain` holds the bodies' chain positions (0 the upper connector, joints + 1 the lower). The upper connector's
+    hinge is at its + end (its axis points down the tube), the lower one's at its − end.
     """
     lengths = np.array(lengths, dtype=float)
     shift = np.zeros(len(chain))
-    for b, name in enumerate(chain):
-        if name in (UPPER, LOWER):
+    for b, position in enumerate(chain):
+        if position in (0, joints + 1):
             lengths[b] -= gap / 2
-            shift[b] = -gap / 4 if name == UPPER else gap / 4
+            shift[b] = -gap / 4 if position == 0 else gap / 4
         else:
             lengths[b] -= gap
     return centres + shift[None, :, None] * axes, np.maximum(lengths, 0.0)
 
 
-def _label(name: str, links: list[str]) -> str:
-    if name == UPPER:
+def _label(position: int, joints: int) -> str:
+    """The label of chain position `position`: the connectors by name, links by number."""
+    if position == 0:
         return "upper connector"
-    if name == LOWER:
+    if position == joints + 1:
         return "lower connector"
-    return f"link {links.index(name) + 1}"
+    return f"link {position}"
 
 
 def _body_axes(quaternions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -52,13 +52,14 @@ fn motion(b: &BodySpec, rot: &Quat, inertia: &Vec3) -> Motion {
             speed: b.spin_speed,
             ramp: b.spin_ramp,
         }),
-        MotionKind::Spin => {
+        MotionKind::Spin | MotionKind::SpinSlide => {
             let axis_body = rot.inverse() * axis;
             let i_axis = axis_body.dot(&inertia.component_mul(&axis_body));
             Motion::Spin {
                 axis,
                 axis_body,
                 inertia: i_axis,
+                slides: b.motion == MotionKind::SpinSlide,
             }
         }
     }
@@ -109,7 +110,8 @@ pub fn tube_segment(spec: &TubeSegmentSpec) -> TubeSegment {
 }
 
 /// The initial state of the scene's bodies (angular velocities to the body
-/// frame; a spin body keeps only its spin about the axis), before the
+/// frame; a spin body keeps only its spin about the axis, and its velocity
+/// along it if it slides), before the
 /// prescribed bodies are placed.
 pub(super) fn initial_state(scene: &Scene, bodies: &[Body]) -> State {
     let mut state = State {
@@ -133,8 +135,18 @@ pub(super) fn initial_state(scene: &Scene, bodies: &[Body]) -> State {
             .collect(),
     };
     for (i, b) in bodies.iter().enumerate() {
-        if let Motion::Spin { axis_body, .. } = b.motion {
-            state.vel[i] = Vec3::zeros();
+        if let Motion::Spin {
+            axis,
+            axis_body,
+            slides,
+            ..
+        } = b.motion
+        {
+            state.vel[i] = if slides {
+                axis * state.vel[i].dot(&axis)
+            } else {
+                Vec3::zeros()
+            };
             state.omega[i] = axis_body * state.omega[i].dot(&axis_body);
         }
     }

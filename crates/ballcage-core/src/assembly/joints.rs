@@ -3,7 +3,7 @@
 use crate::error::SceneError;
 use crate::force::joint::CvJointParams;
 use crate::math::Vec3;
-use crate::model::{Joint, TorqueLoad};
+use crate::model::{ForceLoad, Joint, TorqueLoad};
 use crate::scene::{JointSpec, LoadSpec, Scene};
 
 /// Every declared joint, in order.
@@ -60,18 +60,50 @@ pub(super) fn torque_loads(scene: &Scene) -> Result<Vec<TorqueLoad>, SceneError>
         .loads
         .iter()
         .enumerate()
-        .map(|(i, l)| match l {
+        .filter_map(|(i, l)| match l {
             LoadSpec::Torque {
                 body,
                 axis,
                 magnitude,
                 ramp,
-            } => Ok(TorqueLoad {
-                body: scene.body_id(&format!("loads[{i}].body"), body)?,
-                axis: Vec3::from(*axis).normalize(),
-                magnitude: *magnitude,
-                ramp: *ramp,
-            }),
+            } => Some(
+                scene
+                    .body_id(&format!("loads[{i}].body"), body)
+                    .map(|body| TorqueLoad {
+                        body,
+                        axis: Vec3::from(*axis).normalize(),
+                        magnitude: *magnitude,
+                        ramp: *ramp,
+                    }),
+            ),
+            LoadSpec::Force { .. } => None,
+        })
+        .collect()
+}
+
+/// Every applied force, in order.
+pub(super) fn force_loads(scene: &Scene) -> Result<Vec<ForceLoad>, SceneError> {
+    scene
+        .loads
+        .iter()
+        .enumerate()
+        .filter_map(|(i, l)| match l {
+            LoadSpec::Force {
+                body,
+                axis,
+                force,
+                ramp,
+            } => Some(
+                scene
+                    .body_id(&format!("loads[{i}].body"), body)
+                    .map(|body| ForceLoad {
+                        body,
+                        axis: Vec3::from(*axis).normalize(),
+                        magnitude: *force,
+                        ramp: *ramp,
+                    }),
+            ),
+            LoadSpec::Torque { .. } => None,
         })
         .collect()
 }

@@ -39,6 +39,7 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
     let bodies = bodies::bodies(scene)?;
     let pairs = pairs::contact_pairs(scene, &bodies)?;
     let torques = joints::torque_loads(scene)?;
+    let forces = joints::force_loads(scene)?;
     let joints = joints::joints(scene)?;
     let record = record_plan(scene, &bodies, &pairs)?;
     let mut state = bodies::initial_state(scene, &bodies);
@@ -50,6 +51,7 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         integrated,
         pairs,
         torques,
+        forces,
         joints,
         gravity: Vec3::from(scene.world.gravity),
         integrator: scene.simulation.integrator,

@@ -2,10 +2,10 @@
 
 use super::laws::{friction_law, normal_law};
 use crate::error::SceneError;
-use crate::geometry::{PairGeometry, RingCylinder, Shape};
+use crate::geometry::{LineContact, LineLaw, PairGeometry, RingCylinder, Shape};
 use crate::math::Vec3;
 use crate::model::{Body, ContactPair, Motion};
-use crate::scene::{ContactSpec, FeatureSpec, Scene, ShapeSpec};
+use crate::scene::{ContactSpec, FeatureSpec, LineLawSpec, Scene, ShapeSpec};
 
 /// Every declared contact pair, in order (index = pair id).
 pub(super) fn contact_pairs(
@@ -69,7 +69,14 @@ pub(super) fn pair_geometry(
     shapes: [&Shape; 2],
 ) -> Result<(PairGeometry, bool), SceneError> {
     let Some(feature) = &c.geometry else {
-        return PairGeometry::select(shapes[0], shapes[1], c.points).ok_or_else(|| {
+        let line = LineContact {
+            points: c.points,
+            law: match c.line_law {
+                LineLawSpec::LevelSets => LineLaw::LevelSets,
+                LineLawSpec::Patches => LineLaw::Patches,
+            },
+        };
+        return PairGeometry::select(shapes[0], shapes[1], line).ok_or_else(|| {
             SceneError::new(
                 format!("{path}.bodies"),
                 format!("{:?}", c.bodies),

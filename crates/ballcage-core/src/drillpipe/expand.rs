@@ -11,15 +11,15 @@
 //! four race flanks and two window faces.
 
 use super::cv::CvGeometry;
-use super::layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
-use super::spec::{DrillPipeSpec, HingeModel, MaterialSpec};
+use super::layout::{BodyPart, Feature, HingeLayout, KeyLayout, Layout, PairPart, Part};
+use super::spec::{DrillPipeSpec, HingeModel, LowerEnd, MaterialSpec};
 use super::{chain, names};
 use crate::error::SceneError;
 use crate::geometry::{TubePath, TubeSegment};
 use crate::math::{Mat3, Quat, Vec3};
 use crate::scene::{
-    BodySpec, ContactSpec, FeatureSpec, JointSpec, LoadSpec, MotionKind, RecordSpec, Scene,
-    ShapeSpec, TubeSegmentSpec, WorldSpec,
+    BodySpec, ContactSpec, FeatureSpec, JointSpec, LineLawSpec, LoadSpec, MotionKind, RecordSpec,
+    Scene, ShapeSpec, TubeSegmentSpec, WorldSpec,
 };
 
 /// A drill pipe expanded into the engine's terms.
@@ -80,11 +80,12 @@ impl DrillPipeSpec {
 
     /// Hinge centres in world coordinates (docs/model.md §4, Option A) [m].
     pub fn hinge_positions(&self) -> Vec<Vec3> {
-        chain::place_hinges(
-            &self.extended_centreline(),
-            self.pipe.pitch,
-            self.pipe.joints + 1,
-        )
+        self.hinges_on(&self.extended_centreline())
+    }
+
+    /// Hinge centres placed on `centreline`, the [`Self::extended_centreline`] [m].
+    fn hinges_on(&self, centreline: &TubePath) -> Vec<Vec3> {
+        chain::place_hinges(centreline, self.pipe.pitch, self.pipe.joints + 1)
     }
 
     /// The chain as placed at t = 0: hinge centres 0…n [m] and unit body
@@ -109,14 +110,16 @@ struct Placement {
 }
 
 impl Placement {
+    /// The placement of `spec`'s chain; builds the extended centreline, the
+    /// one of the whole load ([`Layout::centreline`] is it).
     fn new(spec: &DrillPipeSpec) -> Self {
         let n = spec.pipe.joints;
-        let hinges = spec.hinge_positions();
+        let centreline = spec.extended_centreline();
+        let hinges = spec.hinges_on(&centreline);
         let mut axes = vec![TUBE_DIRECTION];
         for k in 1..=n {
             axes.push((hinges[k] - hinges[k - 1]).normalize());
         }
-        let centreline = spec.extended_centreline();
         axes.push(tangent_at(&centreline, &hinges[n]));
         let rotations = axes
             .iter()
@@ -139,11 +142,11 @@ impl Placement {
         let fit = super::sizing::tightest_radius_for_link(
             p.pitch,
             spec.borehole.inner_diameter,
-            p.link_diameter / 2.0,
+            p.link_diameter,
         );
         if r < fit {
             let (d, tube) = (p.link_diameter, spec.borehole.inner_diameter);
-            let longest = super::sizing::longest_link(r, tube, d / 2.0);
+            let longest = super::sizing::longest_link(r, tube, d);
             return Err(SceneError::new(
                 "borehole.curvature_radius",
                 r,
@@ -252,6 +255,7 @@ impl<'a> Builder<'a> {
             contacts: vec![],
             joints: vec![],
             layout: Layout {
+                bodies: vec![BodyPart::of(Part::Tube)],
                 chain: vec![],
                 tube_pairs: vec![],
                 pairs: vec![],
@@ -271,8 +275,9 @@ impl<'a> Builder<'a> {
         names::chain_body(k, self.n())
     }
 
-    fn push_body(&mut self, body: BodySpec) -> usize {
+    fn push_body(&mut self, body: BodySpec, part: BodyPart) -> usize {
         self.bodies.push(body);
+        self.layout.bodies.push(part);
         self.bodies.len() - 1
     }
 
@@ -287,7 +292,7 @@ impl<'a> Builder<'a> {
         let (p, n) = (&self.spec.pipe, self.n());
         let half_c = p.connector_length / 2.0;
         let upper = self.connector(0, self.place.hinges[0] - half_c * self.place.axes[0]);
-        let id = self.push_body(upper);
+        let id = self.push_body(upper, BodyPart::of(Part::Upper));
         self.layout.chain.push(id);
         // The reduced model keeps the chain's mass: each link carries one hinge's
         // cage and keys (half of each of its two hinges).
@@ -312,14 +317,18 @@ impl<'a> Builder<'a> {
                 orientation: quat_array(&self.place.rotations[k]),
                 ..blank_body()
             };
-            let id = self.push_body(link);
+            let part = BodyPart {
+                link: Some(k as u32),
+                ..BodyPart::of(Part::Link)
+            };
+            let id = self.push_body(link, part);
             self.layout.chain.push(id);
         }
         let lower = self.connector(
             n + 1,
             self.place.hinges[n] + half_c * self.place.axes[n + 1],
         );
-        let id = self.push_body(lower);
+        let id = self.push_body(lower, BodyPart::of(Part::Lower));
         self.layout.chain.push(id);
     }
 
@@ -331,10 +340,10 @@ impl<'a> Builder<'a> {
         let omega = drive.speed_rpm * std::f64::consts::TAU / 60.0;
         BodySpec {
             name: self.chain_name(k),
-            motion: if driven {
-                MotionKind::KinematicSpin
-            } else {
-                MotionKind::Spin
+            motion: match (driven, p.lower_end) {
+                (true, _) => MotionKind::KinematicSpin,
+                (false, LowerEnd::Fixed) => MotionKind::Spin,
+                (false, LowerEnd::AxiallyFree) => MotionKind::SpinSlide,
             },
             shape: ShapeSpec::Cylinder {
                 radius: p.connector_diameter / 2.0,
@@ -363,6 +372,7 @@ impl<'a> Builder<'a> {
                 friction: Some(m.friction.clone()),
                 geometry: None,
                 points: self.spec.pipe.tube_contact_points,
+                line_law: self.spec.pipe.tube_contact_law,
             };
             let part = PairPart {
                 link: Some(k as u32),
@@ -449,7 +459,11 @@ impl<'a> Builder<'a> {
             orientation: quat_array(&r_cage),
             ..blank_body()
         };
-        self.push_body(cage);
+        let part = BodyPart {
+            hinge: Some(h as u32),
+            ..BodyPart::of(Part::Cage)
+        };
+        self.push_body(cage, part);
         let mut layout = self.cage_contacts(h, &head, &seat);
         layout.neck = self.neck_contact(h);
         for j in 0..6 {
@@ -474,6 +488,7 @@ impl<'a> Builder<'a> {
             friction: Some(friction.clone()),
             geometry: Some(geometry),
             points: 5,
+            line_law: LineLawSpec::default(),
         };
         self.push_contact(contact, part)
     }
@@ -541,8 +556,13 @@ impl<'a> Builder<'a> {
             ..blank_body()
         };
         let (c_head, c_seat) = self.hinge_anchors(h);
+        let part = BodyPart {
+            hinge: Some(h as u32),
+            key: Some(j as u32),
+            ..BodyPart::of(Part::Key)
+        };
         let mut layout = KeyLayout {
-            body: self.push_body(body),
+            body: self.push_body(body, part),
             tangent: Self::key_tangent(j),
             head_groove: c_head - kb.groove_offset * Vec3::x(),
             seat_groove: c_seat + kb.groove_offset * Vec3::x(),
@@ -627,7 +647,29 @@ impl<'a> Builder<'a> {
         }
     }
 
-    /// The generic scene: the parts plus gravity, the resisting moment and recording.
+    /// The loads on the lower connector: the resisting moment about its
+    /// axis and, with an axially free lower end, the axial force along it
+    /// (positive downhole: tension), both ramped by `load.ramp`.
+    fn lower_loads(&self) -> Vec<LoadSpec> {
+        let (load, axis) = (&self.spec.load, arr(&self.place.axes[self.n() + 1]));
+        let mut loads = vec![LoadSpec::Torque {
+            body: names::LOWER.into(),
+            axis,
+            magnitude: -load.resisting_moment,
+            ramp: load.ramp,
+        }];
+        if self.spec.pipe.lower_end == LowerEnd::AxiallyFree {
+            loads.push(LoadSpec::Force {
+                body: names::LOWER.into(),
+                axis,
+                force: load.axial_force,
+                ramp: load.ramp,
+            });
+        }
+        loads
+    }
+
+    /// The generic scene: the parts plus gravity, the loads and recording.
     fn finish(self) -> Expansion {
         let spec = self.spec;
         let n = self.n();
@@ -644,6 +686,7 @@ impl<'a> Builder<'a> {
             summary_window: r.summary_window.clone(),
             max_bytes: r.max_bytes,
         };
+        let loads = self.lower_loads();
         let scene = Scene {
             name: spec.title(),
             simulation: spec.simulation.clone(),
@@ -653,12 +696,7 @@ impl<'a> Builder<'a> {
             record,
             bodies: self.bodies,
             contacts: self.contacts,
-            loads: vec![LoadSpec::Torque {
-                body: names::LOWER.into(),
-                axis: arr(&self.place.axes[n + 1]),
-                magnitude: -spec.load.resisting_moment,
-                ramp: spec.load.ramp,
-            }],
+            loads,
             joints: self.joints,
         };
         Expansion {

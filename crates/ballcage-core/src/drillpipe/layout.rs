@@ -71,6 +71,58 @@ impl PairPart {
     }
 }
 
+/// What a body of the drill pipe is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Part {
+    /// The fixed guide tube.
+    Tube,
+    /// The driven upper connector.
+    Upper,
+    /// A link.
+    Link,
+    /// The lower connector, loaded by the resisting moment.
+    Lower,
+    /// The cage of a ball-key hinge.
+    Cage,
+    /// A ball key.
+    Key,
+}
+
+impl Part {
+    /// Labels in the order of the variants (the `bodies.part` dictionary).
+    pub const LABELS: &'static [&'static str] = &["tube", "upper", "link", "lower", "cage", "key"];
+
+    /// Index into [`Part::LABELS`].
+    pub fn code(self) -> u32 {
+        self as u32
+    }
+}
+
+/// Which part of the pipe a body is; ids that do not apply are `None`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BodyPart {
+    /// What it is.
+    pub part: Part,
+    /// Link number, 1 at the top (links).
+    pub link: Option<u32>,
+    /// Hinge number, 0 above link 1 (cages and keys).
+    pub hinge: Option<u32>,
+    /// Ball key number, 0–5 (keys).
+    pub key: Option<u32>,
+}
+
+impl BodyPart {
+    /// A body of part `part` with no ids set.
+    pub fn of(part: Part) -> Self {
+        Self {
+            part,
+            link: None,
+            hinge: None,
+            key: None,
+        }
+    }
+}
+
 /// One ball key: its body, its pairs, and its grooves' geometry.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct KeyLayout {
@@ -108,6 +160,8 @@ pub struct HingeLayout {
 /// Body and pair ids of a drill pipe in its scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Layout {
+    /// What each body is, indexed by body id.
+    pub bodies: Vec<BodyPart>,
     /// Body ids in chain order: upper connector, links 1…n, lower connector.
     pub chain: Vec<usize>,
     /// Pair id of link k's contact with the tube at index k − 1.

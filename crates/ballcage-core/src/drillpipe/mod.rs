@@ -6,8 +6,8 @@
 //! paper's defaults, docs/model.md §4) is validated and expanded
 //! ([`DrillPipeSpec::expand`]) into a generic [`Scene`](crate::scene::Scene)
 //! plus the [`Layout`] of its parts by id. Its tables (`links`, `hinges`,
-//! `keys`, `drive`) come from [`PipeTables`], an observer registered with the
-//! simulation through [`crate::record::Observer`].
+//! `keys`, `drive`, `pairs`, `wear`) come from [`PipeTables`], an observer
+//! registered with the simulation through [`crate::record::Observer`].
 //!
 //! | module | job |
 //! |---|---|
@@ -16,7 +16,9 @@
 //! | `names` | the one place part names are formatted |
 //! | `layout` | body and pair ids of the parts |
 //! | `tables` | the drill pipe's output tables and their observer |
-//! | `stress` | Hertz contact pressure and Archard wear of each pair |
+//! | `ids` | the id columns of the `pairs` and `wear` tables |
+//! | `stress` | the Hertz contact model of each pair |
+//! | `wear` | the `wear` table: Archard wear and peak pressure per pair |
 //! | `sizing` | eq. (9) both ways and the articulation limit |
 //! | `chain` | placement along the centreline, eq. (4)/(5) |
 //! | `cv` | exact constant-velocity ball-cage geometry |
@@ -24,18 +26,20 @@
 pub mod chain;
 pub mod cv;
 mod expand;
+mod ids;
 mod layout;
 pub mod names;
 pub mod sizing;
 mod spec;
 pub mod stress;
 pub mod tables;
+pub mod wear;
 
 pub use expand::Expansion;
-pub use layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
+pub use layout::{BodyPart, Feature, HingeLayout, KeyLayout, Layout, PairPart, Part};
 pub use spec::{
     BallKeySpec, BoreholeSpec, DrillPipeSpec, DriveSpec, GravitySpec, HingeModel, IdealCvSpec,
-    KIND, MaterialSpec, MaterialsSpec, PipeRecordSpec, PipeSpec, PipeTable, ResistingMomentSpec,
-    SolidSpec, WearSpec,
+    KIND, LowerEnd, MaterialSpec, MaterialsSpec, PipeRecordSpec, PipeSpec, PipeTable,
+    ResistingMomentSpec, SolidSpec, WearSpec,
 };
 pub use tables::PipeTables;

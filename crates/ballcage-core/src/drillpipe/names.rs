@@ -1,9 +1,10 @@
 //! Names of the drill pipe's parts: the one place they are formatted.
 //!
 //! Names appear in outputs (the `body` and `pair` columns) and in error
-//! messages, for people. Programs use the integer ids of the drill-pipe
-//! tables (`link`, `hinge`, `key`) or the [`Layout`](super::Layout) instead;
-//! nothing parses these names back.
+//! messages, for people. Programs use the ids of the tables (`link`,
+//! `hinge`, `key`; the `bodies` table's `part` and the `pairs` table's
+//! `feature`) or the [`Layout`](super::Layout) instead; nothing parses these
+//! names back.
 
 /// The fixed guide tube.
 pub const TUBE: &str = "tube";

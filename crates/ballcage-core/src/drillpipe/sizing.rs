@@ -5,38 +5,61 @@
 //! (R + D/2)²: the link's corners on the tube's outer wall, its inner face
 //! on the inner wall. Eq. (9) is that triangle solved for L; expanded, its
 //! 2RD − 4Rr + 2Dr − 4r² is 2(D − 2r)(R + r), the form used here.
+//!
+//! The three eq. (9) functions share one vocabulary with `ballcage.sizing`
+//! and `ballcage size`: a rigid *link* of length L and outer diameter d
+//! (r = d/2 in the formulas) in a tube of inner diameter D bent to
+//! centreline radius R, all in metres.
 
 use super::spec::{BallKeySpec, DrillPipeSpec};
 
-/// The paper's eq. (9): the longest rigid link [m] of radius `link_radius`
-/// that fits a tube of inner diameter `tube_diameter` bent to centreline
-/// radius `curvature_radius` [m]: L = 2·√(2(D − 2r)(R + r)).
-pub fn longest_link(curvature_radius: f64, tube_diameter: f64, link_radius: f64) -> f64 {
-    2.0 * (2.0 * (tube_diameter - 2.0 * link_radius) * (curvature_radius + link_radius)).sqrt()
+/// The paper's eq. (9): the longest rigid link [m] of outer diameter
+/// `link_outer_diameter` d that fits a tube of inner diameter
+/// `tube_inner_diameter` D bent to centreline radius `curvature_radius` R
+/// [m]: L = 2·√(2(D − 2r)(R + r)), r = d/2.
+pub fn longest_link(
+    curvature_radius: f64,
+    tube_inner_diameter: f64,
+    link_outer_diameter: f64,
+) -> f64 {
+    let r = link_outer_diameter / 2.0;
+    2.0 * (2.0 * (tube_inner_diameter - 2.0 * r) * (curvature_radius + r)).sqrt()
 }
 
 /// Eq. (9) solved for R: the tightest centreline radius [m] a rigid link of
-/// length `length` fits, R = (L/2)² / (2(D − 2r)) − r; infinite when the
-/// link does not fit the straight tube.
-pub fn tightest_radius_for_link(length: f64, tube_diameter: f64, link_radius: f64) -> f64 {
-    let gap = tube_diameter - 2.0 * link_radius;
+/// length `link_length` and outer diameter `link_outer_diameter` fits in a
+/// tube of inner diameter `tube_inner_diameter` [m],
+/// R = (L/2)² / (2(D − 2r)) − r; infinite when the link does not fit the
+/// straight tube.
+pub fn tightest_radius_for_link(
+    link_length: f64,
+    tube_inner_diameter: f64,
+    link_outer_diameter: f64,
+) -> f64 {
+    let r = link_outer_diameter / 2.0;
+    let gap = tube_inner_diameter - 2.0 * r;
     if gap <= 0.0 {
         return f64::INFINITY;
     }
-    (length / 2.0).powi(2) / (2.0 * gap) - link_radius
+    (link_length / 2.0).powi(2) / (2.0 * gap) - r
 }
 
-/// Eq. (9) solved for r: the largest radius [m] of a rigid link of length
-/// `length` that fits a tube of inner diameter `tube_diameter` bent to
-/// centreline radius `curvature_radius` [m]; `None` when even a link of no
-/// radius does not fit, L > 2·√(2RD).
+/// Eq. (9) solved for d: the largest outer diameter [m] of a rigid link of
+/// length `link_length` that fits a tube of inner diameter
+/// `tube_inner_diameter` bent to centreline radius `curvature_radius` [m];
+/// `None` when even a link of no diameter does not fit, L > 2·√(2RD).
 ///
 /// (L/2)² = 2(D − 2r)(R + r) is 2r² + (2R − D)r + L²/8 − RD = 0, whose
 /// larger root is r = (D − 2R + √((2R + D)² − L²)) / 4 (the smaller one is
 /// negative). For R > D/2 the same root is written without the cancellation
 /// of D − 2R against the square root: r = (8RD − L²) / (4(√((2R + D)² − L²) + 2R − D)).
-pub fn largest_link_radius(length: f64, curvature_radius: f64, tube_diameter: f64) -> Option<f64> {
-    let (l, r, d) = (length, curvature_radius, tube_diameter);
+/// The diameter is 2r.
+pub fn largest_link_diameter(
+    link_length: f64,
+    curvature_radius: f64,
+    tube_inner_diameter: f64,
+) -> Option<f64> {
+    let (l, r, d) = (link_length, curvature_radius, tube_inner_diameter);
     let room = 8.0 * r * d - l * l;
     if room < 0.0 {
         return None;
@@ -47,7 +70,7 @@ pub fn largest_link_radius(length: f64, curvature_radius: f64, tube_diameter: f6
     } else {
         (d - 2.0 * r + root) / 4.0
     };
-    Some(radius)
+    Some(2.0 * radius)
 }
 
 /// The tightest radius [m] at which links of pitch `pitch` bend by
@@ -112,8 +135,7 @@ impl DrillPipeSpec {
         let bend = self
             .articulation_limit()
             .map_or(0.0, |b| tightest_radius_for_bend(p.pitch, b));
-        let fit =
-            tightest_radius_for_link(p.pitch, self.borehole.inner_diameter, p.link_diameter / 2.0);
+        let fit = tightest_radius_for_link(p.pitch, self.borehole.inner_diameter, p.link_diameter);
         bend.max(fit)
     }
 }
@@ -125,8 +147,8 @@ mod tests {
 
     #[test]
     fn eq9_round_trips_and_matches_the_paper_pipe() {
-        // R = 1.5 m, D = 116 mm, r = 43 mm: L = 2·√(2·0.030·1.543) = 0.60854 m.
-        let l = longest_link(1.5, 0.116, 0.043);
+        // R = 1.5 m, D = 116 mm, d = 86 mm (r = 43 mm): L = 2·√(2·0.030·1.543) = 0.60854 m.
+        let l = longest_link(1.5, 0.116, 0.086);
         assert_relative_eq!(
             l,
             2.0 * (2.0 * 0.030 * 1.543_f64).sqrt(),
@@ -134,48 +156,48 @@ mod tests {
         );
         assert_relative_eq!(l, 0.60854, max_relative = 1e-4);
         assert_relative_eq!(
-            tightest_radius_for_link(l, 0.116, 0.043),
+            tightest_radius_for_link(l, 0.116, 0.086),
             1.5,
             max_relative = 1e-12
         );
     }
 
     #[test]
-    fn eq9_solved_for_the_link_radius() {
+    fn eq9_solved_for_the_link_diameter() {
         // R = 1 m, D = 0.1 m, L = √0.41 m: (2R + D)² − L² = 4.41 − 0.41 = 4,
-        // r = (0.1 − 2 + 2) / 4 = 0.025 m; forward, 2·√(2·0.05·1.025) = √0.41.
+        // r = (0.1 − 2 + 2) / 4 = 0.025 m, d = 0.05 m; forward, 2·√(2·0.05·1.025) = √0.41.
         let l = 0.41_f64.sqrt();
-        assert_relative_eq!(longest_link(1.0, 0.1, 0.025), l, max_relative = 1e-14);
-        let r = largest_link_radius(l, 1.0, 0.1).unwrap();
-        assert_relative_eq!(r, 0.025, max_relative = 1e-12);
+        assert_relative_eq!(longest_link(1.0, 0.1, 0.05), l, max_relative = 1e-14);
+        let d = largest_link_diameter(l, 1.0, 0.1).unwrap();
+        assert_relative_eq!(d, 0.05, max_relative = 1e-12);
         // The paper's pipe: the 608.54 mm link of R = 1.5 m is Ø86 mm.
-        let r = largest_link_radius(longest_link(1.5, 0.116, 0.043), 1.5, 0.116).unwrap();
-        assert_relative_eq!(r, 0.043, max_relative = 1e-12);
+        let d = largest_link_diameter(longest_link(1.5, 0.116, 0.086), 1.5, 0.116).unwrap();
+        assert_relative_eq!(d, 0.086, max_relative = 1e-12);
         // A link of no length may be as wide as the bore; one longer than
-        // 2·√(2RD) = 2·√0.2 = 0.89443 m fits at no radius; just below it, a thin one.
+        // 2·√(2RD) = 2·√0.2 = 0.89443 m fits at no diameter; just below it, a thin one.
         assert_relative_eq!(
-            largest_link_radius(0.0, 1.0, 0.1).unwrap(),
-            0.05,
+            largest_link_diameter(0.0, 1.0, 0.1).unwrap(),
+            0.1,
             max_relative = 1e-14
         );
-        assert_eq!(largest_link_radius(0.9, 1.0, 0.1), None);
-        let thin = largest_link_radius(0.894, 1.0, 0.1).unwrap();
-        assert!(thin > 0.0 && thin < 2e-4, "{thin}");
-        // Below R = D/2 the direct form is used: R = 0.04, D = 0.1, r = 0.01 round-trips.
-        let l = longest_link(0.04, 0.1, 0.01);
+        assert_eq!(largest_link_diameter(0.9, 1.0, 0.1), None);
+        let thin = largest_link_diameter(0.894, 1.0, 0.1).unwrap();
+        assert!(thin > 0.0 && thin < 4e-4, "{thin}");
+        // Below R = D/2 the direct form is used: R = 0.04, D = 0.1, d = 0.02 round-trips.
+        let l = longest_link(0.04, 0.1, 0.02);
         assert_relative_eq!(
-            largest_link_radius(l, 0.04, 0.1).unwrap(),
-            0.01,
+            largest_link_diameter(l, 0.04, 0.1).unwrap(),
+            0.02,
             max_relative = 1e-12
         );
         // Round trips over a range of radii, to 1e-12 relative.
         for k in 1..=20 {
-            let (big_r, small_r) = (0.2 * f64::from(k), 0.002 * f64::from(k));
-            let l = longest_link(big_r, 0.116, small_r);
-            let back = largest_link_radius(l, big_r, 0.116).unwrap();
-            assert_relative_eq!(back, small_r, max_relative = 1e-12);
+            let (big_r, d) = (0.2 * f64::from(k), 0.004 * f64::from(k));
+            let l = longest_link(big_r, 0.116, d);
+            let back = largest_link_diameter(l, big_r, 0.116).unwrap();
+            assert_relative_eq!(back, d, max_relative = 1e-12);
             assert_relative_eq!(
-                tightest_radius_for_link(l, 0.116, small_r),
+                tightest_radius_for_link(l, 0.116, d),
                 big_r,
                 max_relative = 1e-12
             );
@@ -211,7 +233,7 @@ mod tests {
             max_relative = 1e-12
         );
         assert_relative_eq!(
-            tightest_radius_for_link(0.2, 0.116, 0.043),
+            tightest_radius_for_link(0.2, 0.116, 0.086),
             0.01 / 0.06 - 0.043,
             max_relative = 1e-12
         );

@@ -7,8 +7,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::SceneError;
 use crate::scene::{
-    DivergenceSpec, FieldUnits, FrictionLawSpec, IntegratorKind, NewtonSpec, NormalLawSpec,
-    RecordSpec, SimulationSpec, TableChoice, TableKind, finite, non_negative, positive,
+    DivergenceSpec, FieldDoc, FieldUnits, FrictionLawSpec, IntegratorKind, LineLawSpec, NewtonSpec,
+    NormalLawSpec, RecordSpec, SimulationSpec, TableChoice, TableKind, finite, law_field,
+    non_negative, positive,
 };
 
 /// The guide tube (borehole) [m, deg].
@@ -21,6 +22,23 @@ pub struct BoreholeSpec {
     pub build_angle_deg: f64,
     /// Guide tube inner diameter [m]. Paper (Table 1): 0.116.
     pub inner_diameter: f64,
+}
+
+impl BoreholeSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number(
+            "curvature_radius",
+            "m",
+            "centreline curvature radius R of the guide tube",
+        ),
+        FieldDoc::number(
+            "build_angle_deg",
+            "deg",
+            "build angle of the arc, from vertical",
+        ),
+        FieldDoc::number("inner_diameter", "m", "guide tube inner diameter D"),
+    ];
 }
 
 impl Default for BoreholeSpec {
@@ -42,6 +60,20 @@ pub enum HingeModel {
     BallKeys,
     /// Reduced model: ideal constant-velocity joints, link–tube contacts only.
     IdealCv,
+}
+
+/// How the lower connector is held (docs/model.md §4, "Connectors").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum LowerEnd {
+    /// The paper's: the centre of mass is held, the connector only spins
+    /// about the tube's end tangent.
+    #[default]
+    Fixed,
+    /// The connector also slides along the tube's end tangent and carries
+    /// `load.axial_force` (weight on bit or overpull): the chain's length
+    /// is free at its lower end.
+    AxiallyFree,
 }
 
 /// Ball-cage joint dimensions and masses (docs/model.md §3) [m, kg, kg·m², deg].
@@ -95,6 +127,41 @@ pub struct BallKeySpec {
     pub mouth_offset: f64,
 }
 
+impl BallKeySpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("ball_radius", "m", "ball key radius r_b"),
+        FieldDoc::number("ball_mass", "kg", "ball key mass"),
+        FieldDoc::number("pitch_radius", "m", "pitch radius of the ball set, PCR"),
+        FieldDoc::number("groove_offset", "m", "groove-centre offset per race, c"),
+        FieldDoc::number("groove_radius", "m", "Gothic-arch flank radius ρ_g"),
+        FieldDoc::number("contact_angle_deg", "deg", "flank contact angle α"),
+        FieldDoc::number("flank_clearance", "m", "ball-flank clearance per flank"),
+        FieldDoc::number("head_radius", "m", "ball head sphere radius"),
+        FieldDoc::number("cage_inner_radius", "m", "cage inner sphere radius"),
+        FieldDoc::number("cage_outer_radius", "m", "cage outer sphere radius"),
+        FieldDoc::number("seat_radius", "m", "ball seat sphere radius"),
+        FieldDoc::number("cage_mass", "kg", "cage mass"),
+        FieldDoc::number(
+            "cage_inertia",
+            "kg·m²",
+            "cage principal inertia, axial then transverse",
+        ),
+        FieldDoc::number(
+            "window_axial_width",
+            "m",
+            "window width along the cage axis",
+        ),
+        FieldDoc::number("window_length", "m", "window length around the cage"),
+        FieldDoc::number("cage_length", "m", "cage length along its axis"),
+        FieldDoc::number(
+            "mouth_offset",
+            "m",
+            "distance from the hinge centre to the seat's mouth, toward the head",
+        ),
+    ];
+}
+
 impl Default for BallKeySpec {
     fn default() -> Self {
         Self {
@@ -133,6 +200,16 @@ pub struct IdealCvSpec {
     pub twist_damping: f64,
 }
 
+impl IdealCvSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("stiffness", "N/m", "hinge-point spring"),
+        FieldDoc::number("damping", "N·s/m", "hinge-point damper"),
+        FieldDoc::number("twist_stiffness", "N·m/rad", "twist spring"),
+        FieldDoc::number("twist_damping", "N·m·s/rad", "twist damper"),
+    ];
+}
+
 impl Default for IdealCvSpec {
     fn default() -> Self {
         Self {
@@ -168,11 +245,18 @@ pub struct PipeSpec {
     pub connector_mass: f64,
     /// Connector principal inertia, axial then transverse [kg·m²].
     pub connector_inertia: [f64; 3],
-    /// Sample points along each link (rims included) that locate its
-    /// contact patches with the tube; each patch carries one force, from its
-    /// largest penetration, so the force does not depend on this count.
-    /// PROPOSAL: 5.
+    /// Sample points along each link (rims included) that bracket the
+    /// extrema of its depth in the tube (or, with `"patches"`, locate its
+    /// contact patches); the force does not depend on this count once each
+    /// extremum has a bracket of its own. PROPOSAL: 5.
     pub tube_contact_points: u32,
+    /// How a link's line contact with the tube becomes point laws:
+    /// `"level-sets"` (the IMPACT law at every depth maximum minus the law
+    /// at every interior depth minimum: continuous in the link's pose, the
+    /// gradient of an energy) or `"patches"` (Adams' one law per patch,
+    /// which jumps when patches merge). PROPOSAL: level-sets
+    /// (docs/model.md §4).
+    pub tube_contact_law: LineLawSpec,
     /// Radius of the ball head's neck, the shaft between the head sphere and
     /// its link [m]. PROPOSAL: 19 mm (Ø38 over the Ø30 bore).
     /// The neck meets the seat's mouth at the articulation limit
@@ -192,6 +276,68 @@ pub struct PipeSpec {
     pub ball_keys: BallKeySpec,
     /// Ideal CV joint details (used by `hinge = "ideal-cv"`).
     pub ideal_cv: IdealCvSpec,
+    /// How the lower connector is held: `"fixed"` (the paper's: its centre
+    /// of mass held, spin only) or `"axially-free"` (it also slides along
+    /// the tube's end tangent, loaded by `load.axial_force`).
+    pub lower_end: LowerEnd,
+}
+
+impl PipeSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("joints", "-", "number of flexible joints (links)"),
+        FieldDoc::text("hinge", "hinge model: ball-keys or ideal-cv"),
+        FieldDoc::number("pitch", "m", "hinge-to-hinge pitch, one link's length"),
+        FieldDoc::number("link_diameter", "m", "link outer diameter for tube contact"),
+        FieldDoc::number("link_mass", "kg", "link mass"),
+        FieldDoc::number(
+            "link_inertia",
+            "kg·m²",
+            "link principal inertia, axial then transverse",
+        ),
+        FieldDoc::number("connector_length", "m", "connector length"),
+        FieldDoc::number("connector_diameter", "m", "connector outer diameter"),
+        FieldDoc::number("connector_mass", "kg", "connector mass"),
+        FieldDoc::number(
+            "connector_inertia",
+            "kg·m²",
+            "connector principal inertia, axial then transverse",
+        ),
+        FieldDoc::number(
+            "tube_contact_points",
+            "-",
+            "sample points along each link that bracket the extrema of its depth in the tube",
+        ),
+        FieldDoc::text(
+            "tube_contact_law",
+            "link-tube line contact as points: level-sets (continuous) or patches (Adams, jumps)",
+        ),
+        FieldDoc::number(
+            "neck_radius",
+            "m",
+            "radius of the ball head's neck; 0 builds no neck contact",
+        ),
+        FieldDoc::number(
+            "link_edge_radius",
+            "m",
+            "radius of the rounded edge of each link's end rim (pressure and wear outputs)",
+        ),
+        FieldDoc::table(
+            "ball_keys",
+            "ball-cage joint dimensions and masses",
+            BallKeySpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "ideal_cv",
+            "ideal constant-velocity hinge parameters",
+            IdealCvSpec::FIELDS,
+        ),
+        FieldDoc::text(
+            "lower_end",
+            "how the lower connector is held: fixed (centre held, spin only; the paper's) or \
+             axially-free (also slides along the tube's end tangent, loaded by load.axial_force)",
+        ),
+    ];
 }
 
 impl Default for PipeSpec {
@@ -208,10 +354,12 @@ impl Default for PipeSpec {
             connector_mass: 17.243,
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
             tube_contact_points: 5,
+            tube_contact_law: LineLawSpec::LevelSets,
             neck_radius: 0.019,
             link_edge_radius: 0.002,
             ball_keys: BallKeySpec::default(),
             ideal_cv: IdealCvSpec::default(),
+            lower_end: LowerEnd::Fixed,
         }
     }
 }
@@ -226,6 +374,14 @@ pub struct DriveSpec {
     pub ramp: f64,
 }
 
+impl DriveSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("speed_rpm", "rpm", "drive speed of the upper connector"),
+        FieldDoc::number("ramp", "s", "STEP ramp from rest to full speed"),
+    ];
+}
+
 impl Default for DriveSpec {
     fn default() -> Self {
         Self {
@@ -235,14 +391,57 @@ impl Default for DriveSpec {
     }
 }
 
-/// The resisting moment on the lower connector.
+/// The loads on the lower connector: the resisting moment and an axial force.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ResistingMomentSpec {
     /// Resisting moment, opposing the spin [N·m]. Paper: 1800.
     pub resisting_moment: f64,
-    /// STEP ramp [s]; 0 applies it at once. PROPOSAL: 0.3.
+    /// STEP ramp of both loads [s]; 0 applies them at once. PROPOSAL: 0.3.
     pub ramp: f64,
+    /// Axial force on the lower connector along the tube's end tangent [N]:
+    /// positive pulls it downhole, away from the chain (tension, overpull),
+    /// negative pushes it uphole into the chain (compression, weight on
+    /// bit). Needs `pipe.lower_end = "axially-free"`. Default 0 (the paper
+    /// applies none).
+    pub axial_force: f64,
+}
+
+impl ResistingMomentSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number(
+            "resisting_moment",
+            "N·m",
+            "resisting moment on the lower connector, opposing the spin",
+        ),
+        FieldDoc::number(
+            "ramp",
+            "s",
+            "STEP ramp of the moment and the axial force; 0 applies them at once",
+        ),
+        FieldDoc::number(
+            "axial_force",
+            "N",
+            "axial force on the lower connector along the tube's end tangent: positive = tension \
+             (overpull, pulls it downhole), negative = compression (weight on bit); needs \
+             pipe.lower_end = \"axially-free\"",
+        ),
+    ];
+
+    /// The axial force: finite, and only on an axially free lower end.
+    fn validate_axial_force(&self, lower_end: LowerEnd) -> Result<(), SceneError> {
+        finite("load.axial_force", self.axial_force)?;
+        if self.axial_force != 0.0 && lower_end == LowerEnd::Fixed {
+            return Err(SceneError::new(
+                "load.axial_force",
+                self.axial_force,
+                "needs pipe.lower_end = \"axially-free\": with the fixed lower end the connector's \
+                 centre is held, so the force would only be carried by that restraint and change nothing",
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl Default for ResistingMomentSpec {
@@ -250,6 +449,7 @@ impl Default for ResistingMomentSpec {
         Self {
             resisting_moment: 1800.0,
             ramp: 0.3,
+            axial_force: 0.0,
         }
     }
 }
@@ -262,6 +462,14 @@ pub struct MaterialSpec {
     pub normal: NormalLawSpec,
     /// Friction law.
     pub friction: FrictionLawSpec,
+}
+
+impl MaterialSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::law("normal", "normal force law", law_field),
+        FieldDoc::law("friction", "friction law", law_field),
+    ];
 }
 
 fn paper_impact() -> NormalLawSpec {
@@ -301,6 +509,18 @@ pub struct SolidSpec {
 }
 
 impl SolidSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("youngs_modulus", "Pa", "Young's modulus E"),
+        FieldDoc::number("poisson_ratio", "-", "Poisson's ratio ν"),
+        FieldDoc::number("hardness", "Pa", "indentation hardness H, for Archard wear"),
+        FieldDoc::number(
+            "allowable_pressure",
+            "Pa",
+            "largest static peak contact pressure p₀ the surface may carry",
+        ),
+    ];
+
     /// 35CrMo, quenched and tempered, the paper's material for the guide
     /// tube and the drill pipe: E 210 GPa and ν 0.3 as the paper gives them.
     /// PROPOSAL: hardness HV 300 (2.94 GPa; Q&T 35CrMo is HB 270–300) and
@@ -361,6 +581,28 @@ pub struct MaterialsSpec {
     pub key_steel: SolidSpec,
 }
 
+impl MaterialsSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::table(
+            "tube",
+            "link-guide tube contact (dry)",
+            MaterialSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "internal",
+            "contacts inside the joints (lubricated)",
+            MaterialSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "pipe_steel",
+            "the solid of the links, connectors, heads, seats, cages and tube",
+            SolidSpec::FIELDS,
+        ),
+        FieldDoc::table("key_steel", "the solid of the ball keys", SolidSpec::FIELDS),
+    ];
+}
+
 impl Default for MaterialsSpec {
     fn default() -> Self {
         Self {
@@ -404,6 +646,20 @@ impl Default for WearSpec {
 }
 
 impl WearSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number(
+            "tube_coefficient",
+            "-",
+            "Archard wear coefficient k of the link-guide tube contacts",
+        ),
+        FieldDoc::number(
+            "internal_coefficient",
+            "-",
+            "Archard wear coefficient k of the contacts inside the joints",
+        ),
+    ];
+
     fn validate(&self) -> Result<(), SceneError> {
         non_negative("wear.tube_coefficient", self.tube_coefficient)?;
         non_negative("wear.internal_coefficient", self.internal_coefficient)
@@ -416,6 +672,15 @@ impl WearSpec {
 pub struct GravitySpec {
     /// [m/s²]. Paper: 9.8.
     pub gravity: f64,
+}
+
+impl GravitySpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[FieldDoc::number(
+        "gravity",
+        "m/s²",
+        "gravity's magnitude, pointing along -z",
+    )];
 }
 
 impl Default for GravitySpec {
@@ -435,8 +700,10 @@ pub struct DrillPipeSpec {
     #[serde(skip_serializing_if = "String::is_empty")]
     pub name: String,
     /// Time stepping. The paper's 1 ms is the output interval, not the step.
-    /// Default: SDIRK2 at 100 µs, within 0.1 % of a converged reference on
-    /// every quantity of `ballcage accuracy` (docs/accuracy.md). Explicit
+    /// Default: SDIRK2 at 100 µs: against a converged reference, every
+    /// time-averaged force and peak of `ballcage accuracy` within 0.21 %, an
+    /// instantaneous bend of a nearly straight link within 5 %
+    /// (docs/accuracy.md). Explicit
     /// integrators need 0.1 µs here: at 1 µs the lubricated key friction (a
     /// damper of rate ~4e6 1/s at 10 kN) chatters, and even 0.2 µs drifts
     /// once the keys carry their full load (docs/paper.md).
@@ -449,7 +716,7 @@ pub struct DrillPipeSpec {
     pub pipe: PipeSpec,
     /// Drive.
     pub drive: DriveSpec,
-    /// Resisting moment.
+    /// Resisting moment and axial force.
     pub load: ResistingMomentSpec,
     /// Contact materials and solids.
     pub materials: MaterialsSpec,
@@ -463,6 +730,40 @@ pub struct DrillPipeSpec {
 pub const KIND: &str = "drill-pipe";
 
 impl DrillPipeSpec {
+    /// The unit and meaning of every field of a drill-pipe document.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("kind", "always \"drill-pipe\""),
+        FieldDoc::text(
+            "name",
+            "scene name; empty names the scene after its chain, tube and loads",
+        ),
+        FieldDoc::table("simulation", "time stepping", SimulationSpec::FIELDS),
+        FieldDoc::table("world", "gravity", GravitySpec::FIELDS),
+        FieldDoc::table("borehole", "the guide tube", BoreholeSpec::FIELDS),
+        FieldDoc::table("pipe", "the chain", PipeSpec::FIELDS),
+        FieldDoc::table(
+            "drive",
+            "the drive on the upper connector",
+            DriveSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "load",
+            "the resisting moment and the axial force on the lower connector",
+            ResistingMomentSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "materials",
+            "contact materials and solids",
+            MaterialsSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "wear",
+            "Archard wear coefficients of the wear table",
+            WearSpec::FIELDS,
+        ),
+        FieldDoc::table("record", "what to record", PipeRecordSpec::FIELDS),
+    ];
+
     /// The scene's name: `name` if set, else its chain, tube and loads, e.g.
     /// "12 ball-cage joints, R 1.5 m, 100 rpm, 1.8 kN·m", prefixed with
     /// "Zhu et al. 2023: " when those are the paper's.
@@ -596,7 +897,7 @@ impl TableChoice for PipeTable {
 }
 
 /// What a drill-pipe scene records: the engine's tables and the drill
-/// pipe's (`links`, `hinges`, `keys`, `drive`). `bodies` names parts (e.g.
+/// pipe's (`links`, `hinges`, `keys`, `drive`, `pairs`, `wear`). `bodies` names parts (e.g.
 /// `link03`); empty means the connectors and the links.
 pub type PipeRecordSpec = RecordSpec<PipeTable>;
 
@@ -626,6 +927,7 @@ impl DrillPipeSpec {
             finite("drive.speed_rpm", self.drive.speed_rpm),
             finite("load.resisting_moment", self.load.resisting_moment),
             non_negative("load.ramp", self.load.ramp),
+            self.load.validate_axial_force(self.pipe.lower_end),
             finite("world.gravity", self.world.gravity),
             self.materials.pipe_steel.validate("materials.pipe_steel"),
             self.materials.key_steel.validate("materials.key_steel"),

@@ -1,16 +1,19 @@
 //! The drill pipe's own output tables, filled by an [`Observer`] the
 //! drill-pipe layer registers with the simulation: `links`, `hinges`,
-//! `keys` and `drive`. Parts are identified by integer columns (`link`,
-//! `hinge`, `key`), never by names.
+//! `keys`, `drive`, `pairs` and `wear` (defined in [`super::wear`]). Parts
+//! are identified by integer columns (`link`, `hinge`, `key`), never by
+//! names.
 
-use super::layout::{Feature, HingeLayout, KeyLayout, Layout, PairPart};
+use super::ids::{FEATURE, HINGE, KEY, LINK, PAIR, PAIR_ID, pair_cells};
+use super::layout::{Feature, HingeLayout, KeyLayout, Layout, Part};
 use super::spec::{DrillPipeSpec, PipeTable};
-use super::stress::{PairStress, PairWear, WEAR, pair_stresses, wear_rows};
+use super::stress::{PairStress, pair_stresses};
+use super::wear::{PairWear, WEAR, wear_rows};
 use crate::math::{Vec3, angle_between};
 use crate::model::{Model, Motion, State};
 use crate::record::{
-    Cell, ColumnDef, ColumnKind, Dictionary, Frame, Observer, STEP, Step, TIME, TableBuffer,
-    TableDef, col, contact_totals,
+    BodyParts, Cell, ColumnDef, ColumnKind, Dictionary, Frame, Observer, PartIds, STEP, Step, TIME,
+    TableBuffer, TableDef, col, contact_totals,
 };
 
 use ColumnKind::{F64, Name, OptF64, OptU32, U32};
@@ -313,57 +316,6 @@ const DRIVE_COLUMNS: &[ColumnDef] = &[
     ),
 ];
 
-/// The columns that say which pair a row is and where it sits in the pipe:
-/// the first six of the `pairs` and `wear` tables ([`pair_cells`]).
-pub(super) const PAIR_ID: ColumnDef = col(
-    "pair_id",
-    U32,
-    "",
-    "contact pair index in the scene's contact list (the contacts and summary tables' pair_id)",
-);
-/// See [`PAIR_ID`].
-pub(super) const PAIR: ColumnDef = col("pair", Name(Dictionary::Pairs), "", "contact pair name");
-/// See [`PAIR_ID`].
-pub(super) const FEATURE: ColumnDef = col(
-    "feature",
-    Name(Dictionary::Labels(Feature::LABELS)),
-    "",
-    "what the pair touches: tube, cage-head, cage-seat, inner-race, outer-race, window or neck-mouth",
-);
-/// See [`PAIR_ID`].
-pub(super) const LINK: ColumnDef = col(
-    "link",
-    OptU32,
-    "",
-    "link number, 1 at the top (tube pairs; null otherwise)",
-);
-/// See [`PAIR_ID`].
-pub(super) const HINGE: ColumnDef = col(
-    "hinge",
-    OptU32,
-    "",
-    "hinge number, 0 above link 1 (joint pairs; null otherwise)",
-);
-/// See [`PAIR_ID`].
-pub(super) const KEY: ColumnDef = col(
-    "key",
-    OptU32,
-    "",
-    "ball key number, 0-5 (key pairs; null otherwise)",
-);
-
-/// The cells of [`PAIR_ID`] … [`KEY`] for pair `k`, `part`.
-pub(super) fn pair_cells(k: usize, part: &PairPart) -> [Cell; 6] {
-    [
-        Cell::U32(k as u32),
-        Cell::U32(k as u32),
-        Cell::U32(part.feature.code()),
-        Cell::OptU32(part.link),
-        Cell::OptU32(part.hinge),
-        Cell::OptU32(part.key),
-    ]
-}
-
 /// Columns of the `pairs` table (drill pipe): one row per contact pair, written once.
 const PAIRS_COLUMNS: &[ColumnDef] = &[
     PAIR_ID,
@@ -530,6 +482,19 @@ impl Observer for PipeTables {
                 wear_rows(table, &self.layout, &self.stress, &self.wear, window);
             }
         }
+    }
+
+    fn body_parts(&self) -> Option<BodyParts> {
+        let ids = self.layout.bodies.iter().map(|b| PartIds {
+            part: Some(b.part.code()),
+            link: b.link,
+            hinge: b.hinge,
+            key: b.key,
+        });
+        Some(BodyParts {
+            labels: Part::LABELS,
+            ids: ids.collect(),
+        })
     }
 
     fn clone_box(&self) -> Box<dyn Observer> {

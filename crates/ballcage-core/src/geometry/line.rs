@@ -1,39 +1,46 @@
-//! A cylinder (a drill-pipe link) inside a tube: a line contact reduced to
-//! one point per contact patch.
+//! A cylinder (a drill-pipe link) inside a tube: a line contact as points.
 //!
 //! MSC Adams, and so the paper, applies its IMPACT law once per contact
-//! patch, with the patch's largest penetration. ballcage does the same: the
-//! force a link gets does not depend on how finely it is sampled. A link
-//! pressed uniformly into the wall at depth δ gets the single-point law at δ
-//! for any sample count, and a link touching at one rim gets the
-//! single-point law at that rim (docs/model.md §7.6). The force acts at the
-//! patch's centre of pressure, the depth-weighted centroid of its sampled
-//! surface points (PROPOSAL: a link lying along the wall then feels no
-//! torque from where round-off puts its deepest sample, and a tilting link
-//! feels its centre of pressure move continuously toward the deeper end).
+//! patch at the patch's largest penetration. That force jumps when patches
+//! merge or split (two patches of depth δ each carry 2·Kδⁿ, one merged patch
+//! Kδⁿ), and a point at the patch's sampled centroid moves its moment with
+//! the sample count. ballcage's default, the level-set law
+//! ([`LineLaw::LevelSets`], docs/model.md §4), keeps what Adams gets
+//! right and removes both defects:
+//! - a link pressed uniformly into the wall at depth δ gets the single-point
+//!   law at δ, and a link touching at one rim the single-point law at that
+//!   rim (one depth maximum, no minimum);
+//! - two separate patches get one point law each, as in Adams;
+//! - between those, the energy Σ Φ(δ_max) − Σ Φ(δ_min) over the exact depth
+//!   extrema (Φ the point law's elastic energy) counts the connected pieces
+//!   of the contact at each depth, so force, moment and energy are
+//!   continuous in the link's pose, and the elastic force is the gradient
+//!   of that energy: each maximum carries the point law along its normal,
+//!   each interior minimum the point law with the sign reversed
+//!   ([`ContactPoint::weight`] = −1).
 //!
-//! The geometry is `ballcage_shapes::line::line_patches` (its module doc
-//! derives how the deepest point between two samples is found exactly),
-//! the code parry and rapier use through `ballcage_shapes::ShapeDispatcher`;
-//! this function places the link in the tube's frame and the patches back
-//! in the world.
+//! The extrema are found exactly (`ballcage_shapes::line::line_extrema`):
+//! the samples only bracket them, so the answer does not depend on the
+//! sample count once each extremum has its own bracket. The earlier law
+//! stays as [`LineLaw::Patches`] for comparison
+//! (`ballcage_shapes::line::line_patches`).
 
 use ballcage_shapes::Rod;
-use ballcage_shapes::line::{Ends, line_patches};
+use ballcage_shapes::line::{Ends, line_extrema, line_patches};
 
-use super::{ContactPoint, TubePath};
+use super::{ContactPoint, LineContact, LineLaw, TubePath};
 use crate::math::{Quat, Vec3, from_glam, to_glam};
 
 /// Contact points of a cylinder (`radius`, `half_length`, axis along its
-/// body x) at pose `pc` inside tube `t` at pose `pt`: one per patch, from
-/// `points` samples along the axis (rims included) that locate the patches.
+/// body x) at pose `pc` inside tube `t` at pose `pt`, by the `line`
+/// contact's law, from its samples along the axis (rims included).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn cylinder_tube(
     t: &TubePath,
     pt: (&Vec3, &Quat),
     radius: f64,
     half_length: f64,
-    points: u32,
+    line: LineContact,
     pc: (&Vec3, &Quat),
     out: &mut Vec<ContactPoint>,
 ) {
@@ -44,14 +51,30 @@ pub(super) fn cylinder_tube(
         half_length,
         radius,
     };
-    line_patches(t.interior(), &rod, Ends::Flat, points, 0.0, &mut |c| {
+    let mut push = |c: ballcage_shapes::LocalContact, weight: f64| {
         out.push(ContactPoint {
             slot: c.feature,
             point: pt.0 + pt.1 * from_glam(c.point),
             normal: pt.1 * from_glam(c.normal),
             depth: c.depth,
+            weight,
         })
-    });
+    };
+    match line.law {
+        LineLaw::LevelSets => line_extrema(
+            t.interior(),
+            &rod,
+            Ends::Flat,
+            line.points,
+            0.0,
+            &mut |c, kind| push(c, kind.weight()),
+        ),
+        LineLaw::Patches => {
+            line_patches(t.interior(), &rod, Ends::Flat, line.points, 0.0, &mut |c| {
+                push(c, 1.0)
+            })
+        }
+    }
 }
 
 #[cfg(test)]
@@ -71,7 +94,11 @@ mod tests {
             half_length,
         };
         let mut out = vec![];
-        PairGeometry::CylinderTube { points }.contacts(
+        PairGeometry::CylinderTube(LineContact {
+            points,
+            law: LineLaw::Patches,
+        })
+        .contacts(
             tube,
             (&Vec3::zeros(), &Quat::identity()),
             &cyl,

@@ -101,6 +101,38 @@ pub struct ContactPoint {
     pub normal: Vec3,
     /// Overlap δ > 0 [m].
     pub depth: f64,
+    /// The sign with which this point's law enters its pair: +1, except at
+    /// a depth minimum of the level-set line law ([`LineLaw::LevelSets`]),
+    /// where the point law is subtracted (−1). Forces, their derivatives
+    /// and the elastic energy of the point are multiplied by it.
+    pub weight: f64,
+}
+
+/// How a cylinder–tube pair turns its line contact into points
+/// (docs/model.md §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LineLaw {
+    /// The point law at every depth maximum minus the point law at every
+    /// interior depth minimum: the energy Σ Φ(δ_max) − Σ Φ(δ_min) counts the
+    /// connected pieces of the contact at each depth, so force, moment and
+    /// energy are continuous when pieces appear, merge or split, and the
+    /// elastic force is the energy's gradient.
+    #[default]
+    LevelSets,
+    /// One point law per contact patch at its largest penetration, acting
+    /// at the patch's depth-weighted centroid (MSC Adams' solid contact;
+    /// the earlier default, kept for comparison): it jumps when patches
+    /// merge or split.
+    Patches,
+}
+
+/// The sampling and law of a cylinder–tube line contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LineContact {
+    /// Samples along the axis (rims included) that locate the contact.
+    pub points: u32,
+    /// How the line contact becomes points.
+    pub law: LineLaw,
 }
 
 /// How a pair's contact points are found; chosen once, at assembly.
@@ -110,11 +142,8 @@ pub enum PairGeometry {
     ParryConvex,
     /// Cuboid vertices against a half-space, up to 8 points.
     CuboidHalfSpace,
-    /// Cylinder inside a tube: one point per contact patch, at its deepest.
-    CylinderTube {
-        /// Samples along the axis (rims included) that locate the patches.
-        points: u32,
-    },
+    /// Cylinder inside a tube: a line contact, as points by its [`LineLaw`].
+    CylinderTube(LineContact),
     /// Ball inside a tube.
     BallTube,
     /// Ball (b) inside the tube of a torus on body a (a groove flank); vectors in a's frame.
@@ -162,9 +191,9 @@ impl PairGeometry {
         "ball–half-space, ball–ball, ball–cuboid, cuboid–half-space, cylinder–tube, ball–tube";
 
     /// The method for a pair of shapes in either order (with the
-    /// cylinder–tube sample count), or `None` if unsupported. The returned
-    /// flag is true when the canonical order is (b, a).
-    pub fn select(a: &Shape, b: &Shape, points: u32) -> Option<(Self, bool)> {
+    /// cylinder–tube line contact's sampling and law), or `None` if
+    /// unsupported. The returned flag is true when the canonical order is (b, a).
+    pub fn select(a: &Shape, b: &Shape, line: LineContact) -> Option<(Self, bool)> {
         use Shape as S;
         let canonical = |x: &Shape, y: &Shape| -> Option<Self> {
             match (x, y) {
@@ -174,7 +203,7 @@ impl PairGeometry {
                 (S::HalfSpace(_), S::Ball(_)) => Some(Self::ParryConvex),
                 (S::Ball(_), S::Ball(_) | S::Cuboid(_)) => Some(Self::ParryConvex),
                 (S::Cuboid(_), S::HalfSpace(_)) => Some(Self::CuboidHalfSpace),
-                (S::Tube(_), S::Cylinder { .. }) => Some(Self::CylinderTube { points }),
+                (S::Tube(_), S::Cylinder { .. }) => Some(Self::CylinderTube(line)),
                 (S::Tube(_), S::Ball(_)) => Some(Self::BallTube),
                 _ => None,
             }
@@ -215,7 +244,12 @@ impl PairGeometry {
             | Self::CavitySphere { .. }
             | Self::RingCylinder(_) => 1,
             Self::CuboidHalfSpace => 8,
-            Self::CylinderTube { points } => points as usize,
+            // Level sets: maxima at 0..n, interior minima at n..2n − 1.
+            Self::CylinderTube(LineContact {
+                points,
+                law: LineLaw::LevelSets,
+            }) => 2 * points as usize,
+            Self::CylinderTube(LineContact { points, .. }) => points as usize,
         }
     }
 
@@ -235,13 +269,13 @@ impl PairGeometry {
                 cuboid_half_space(c, p1, h, p2, out)
             }
             (
-                Self::CylinderTube { points },
+                Self::CylinderTube(line),
                 Shape::Tube(t),
                 Shape::Cylinder {
                     radius,
                     half_length,
                 },
-            ) => line::cylinder_tube(t, p1, *radius, *half_length, points, p2, out),
+            ) => line::cylinder_tube(t, p1, *radius, *half_length, line, p2, out),
             (Self::BallTube, Shape::Tube(t), Shape::Ball(b)) => ball_tube(t, p1, b.radius, p2, out),
             (
                 Self::TorusBall {
@@ -313,6 +347,7 @@ fn parry_convex(
             point: 0.5 * (from_glam(c.point1) + from_glam(c.point2)),
             normal: from_glam(c.normal1),
             depth: -c.dist,
+            weight: 1.0,
         });
     }
 }
@@ -350,6 +385,7 @@ fn cuboid_half_space(
                 point: v - 0.5 * d * n,
                 normal: -n,
                 depth: -d,
+                weight: 1.0,
             });
         }
     }
@@ -363,6 +399,7 @@ fn placed(c: LocalContact, pa: (&Vec3, &Quat)) -> Option<ContactPoint> {
         point: pa.0 + pa.1 * from_glam(c.point),
         normal: pa.1 * from_glam(c.normal),
         depth: c.depth,
+        weight: 1.0,
     })
 }
 
@@ -440,6 +477,7 @@ fn cavity_sphere(
             point: from_glam(c.point),
             normal: from_glam(c.normal),
             depth: c.depth,
+            weight: 1.0,
         });
     }
 }
@@ -448,6 +486,11 @@ fn cavity_sphere(
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    const LINE: LineContact = LineContact {
+        points: 5,
+        law: LineLaw::LevelSets,
+    };
 
     fn pose(p: [f64; 3]) -> (Vec3, Quat) {
         (Vec3::from(p), Quat::identity())
@@ -459,11 +502,11 @@ mod tests {
         let ball = Shape::ball(0.1);
         // Declared either way round, the pair resolves to half-space first.
         assert_eq!(
-            PairGeometry::select(&ball, &ground, 5),
+            PairGeometry::select(&ball, &ground, LINE),
             Some((PairGeometry::ParryConvex, true))
         );
         assert_eq!(
-            PairGeometry::select(&ground, &ball, 5),
+            PairGeometry::select(&ground, &ball, LINE),
             Some((PairGeometry::ParryConvex, false))
         );
         for z in [0.099, 0.0999, 0.05] {

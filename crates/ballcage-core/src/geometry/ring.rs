@@ -60,6 +60,7 @@ impl RingCylinder {
             point: c - 0.5 * depth * normal,
             normal,
             depth,
+            weight: 1.0,
         });
     }
 }

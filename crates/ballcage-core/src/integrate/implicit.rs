@@ -4,8 +4,9 @@
 //! # Linearly implicit Euler
 //! The unknowns are the twist increments of the integrated bodies in the
 //! world frame: a dynamic body has Δv (3) and Δω (3), a `spin` body the one
-//! spin-rate increment about its axis. Per body a basis B maps them to a
-//! world twist [v; ω] (B = I₆, or B = [0; axis]); fixed and kinematic bodies
+//! spin-rate increment about its axis, a `spin-slide` body that and the
+//! speed increment along the axis. Per body a basis B maps them to a world
+//! twist [v; ω] (B = I₆, B = [0; axis] or [axis, 0; 0, axis]); fixed and kinematic bodies
 //! carry no unknowns (their velocities are prescribed). One step of `h`:
 //!
 //! 1. one force evaluation at (x_n, v_n) giving the wrenches f (gravity,
@@ -78,6 +79,9 @@ enum Basis {
     Full,
     /// One unknown, the spin rate about this world axis: B = [0; axis].
     Axis(Vec3),
+    /// Two unknowns, the speed along and the spin rate about this world
+    /// axis (a `spin-slide` body): B = [axis, 0; 0, axis].
+    Slide(Vec3),
 }
 
 impl Basis {
@@ -85,6 +89,17 @@ impl Basis {
         match self {
             Self::Full => 6,
             Self::Axis(_) => 1,
+            Self::Slide(_) => 2,
+        }
+    }
+
+    /// Per unknown of a reduced basis: where its axis sits in the twist
+    /// [v; ω] (0 for v, 3 for ω) and the axis. Empty for `Full`.
+    fn columns(self) -> [Option<(usize, Vec3)>; 2] {
+        match self {
+            Self::Full => [None, None],
+            Self::Axis(u) => [Some((3, u)), None],
+            Self::Slide(u) => [Some((0, u)), Some((3, u))],
         }
     }
 }
@@ -309,7 +324,13 @@ impl Implicit {
                 (Basis::Axis(_), Motion::Spin { axis_body, .. }) => {
                     state.omega[i] += axis_body * dq[0];
                 }
-                (Basis::Axis(_), _) => unreachable!("only spin bodies have an axis basis"),
+                (Basis::Slide(axis), Motion::Spin { axis_body, .. }) => {
+                    state.vel[i] += axis * dq[0];
+                    state.omega[i] += axis_body * dq[1];
+                }
+                (Basis::Axis(_) | Basis::Slide(_), _) => {
+                    unreachable!("only spin bodies have an axis basis")
+                }
             }
             state.pos[i] += h * state.vel[i];
             state.rot[i] *= exp_map(&(h * state.omega[i]));
@@ -550,6 +571,10 @@ impl Implicit {
             let w = state.omega_world(i);
             match basis {
                 Basis::Axis(axis) => self.v_n[off] = w.dot(&axis),
+                Basis::Slide(axis) => {
+                    self.v_n[off] = state.vel[i].dot(&axis);
+                    self.v_n[off + 1] = w.dot(&axis);
+                }
                 Basis::Full => {
                     for c in 0..3 {
                         self.v_n[off + c] = state.vel[i][c];
@@ -588,6 +613,12 @@ impl Implicit {
                     start.vel[i],
                     axis * self.v[off],
                 ),
+                Basis::Slide(axis) => (
+                    axis * self.base[off],
+                    axis * self.base[off + 1],
+                    axis * self.v[off],
+                    axis * self.v[off + 1],
+                ),
                 Basis::Full => (
                     Vec3::new(self.base[off], self.base[off + 1], self.base[off + 2]),
                     Vec3::new(self.base[off + 3], self.base[off + 4], self.base[off + 5]),
@@ -619,7 +650,14 @@ impl Implicit {
                 (Basis::Axis(axis), Motion::Spin { inertia, .. }) => {
                     self.rhs[off] = -(inertia * dv(off) - gh * torque[i].dot(&axis));
                 }
-                (Basis::Axis(_), _) => unreachable!("only spin bodies have an axis basis"),
+                (Basis::Slide(axis), Motion::Spin { inertia, .. }) => {
+                    let m = model.bodies[i].mass;
+                    self.rhs[off] = -(m * dv(off) - gh * force[i].dot(&axis));
+                    self.rhs[off + 1] = -(inertia * dv(off + 1) - gh * torque[i].dot(&axis));
+                }
+                (Basis::Axis(_) | Basis::Slide(_), _) => {
+                    unreachable!("only spin bodies have an axis basis")
+                }
                 (Basis::Full, _) => {
                     let m = model.bodies[i].mass;
                     let inertia_w = world_inertia(model, stage, i);
@@ -645,6 +683,10 @@ impl Implicit {
             match basis {
                 // ω ∥ axis: the gyroscopic torque has no part along it.
                 Basis::Axis(axis) => self.rhs[off] = h * torque[i].dot(&axis),
+                Basis::Slide(axis) => {
+                    self.rhs[off] = h * force[i].dot(&axis);
+                    self.rhs[off + 1] = h * torque[i].dot(&axis);
+                }
                 Basis::Full => {
                     let inertia_w = world_inertia(model, state, i);
                     let w = state.omega_world(i);
@@ -670,6 +712,10 @@ impl Implicit {
             let mut mass = Mat6::zeros();
             match (self.dofs[i].expect("integrated").1, body.motion) {
                 (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass[(0, 0)] = inertia,
+                (Basis::Slide(_), Motion::Spin { inertia, .. }) => {
+                    mass[(0, 0)] = body.mass;
+                    mass[(1, 1)] = inertia;
+                }
                 _ => {
                     mass.fixed_view_mut::<3, 3>(0, 0).fill_diagonal(body.mass);
                     mass.fixed_view_mut::<3, 3>(3, 3)
@@ -738,6 +784,9 @@ fn unknowns(model: &Model) -> (Vec<Option<(usize, Basis)>>, usize) {
     let mut n = 0;
     for &i in &model.integrated {
         let basis = match model.bodies[i].motion {
+            Motion::Spin {
+                axis, slides: true, ..
+            } => Basis::Slide(axis),
             Motion::Spin { axis, .. } => Basis::Axis(axis),
             _ => Basis::Full,
         };
@@ -756,6 +805,10 @@ fn mass_scales(model: &Model, dofs: &[Option<(usize, Basis)>], n: usize) -> Vec<
         let body = &model.bodies[i];
         match (basis, body.motion) {
             (Basis::Axis(_), Motion::Spin { inertia, .. }) => mass_scale[off] = inertia,
+            (Basis::Slide(_), Motion::Spin { inertia, .. }) => {
+                mass_scale[off] = body.mass;
+                mass_scale[off + 1] = inertia;
+            }
             _ => {
                 let rot = body.inertia.max();
                 mass_scale[off..off + 6]
@@ -775,20 +828,29 @@ fn world_inertia(model: &Model, state: &State, i: usize) -> Mat3 {
 /// B_iᵀ·m·B_j in the leading corner of a 6 × 6 block (the rest zero).
 fn project(bi: Basis, bj: Basis, m: &Mat6) -> Mat6 {
     let mut out = Mat6::zeros();
+    let (ci, cj) = (bi.columns(), bj.columns());
     match (bi, bj) {
         (Basis::Full, Basis::Full) => out = *m,
-        (Basis::Full, Basis::Axis(u)) => {
-            for r in 0..6 {
-                out[(r, 0)] = m.fixed_view::<1, 3>(r, 3).transpose().dot(&u);
+        (Basis::Full, _) => {
+            for (c, (off, u)) in cj.iter().enumerate().filter_map(|(c, x)| Some((c, (*x)?))) {
+                for r in 0..6 {
+                    out[(r, c)] = m.fixed_view::<1, 3>(r, off).transpose().dot(&u);
+                }
             }
         }
-        (Basis::Axis(u), Basis::Full) => {
-            for c in 0..6 {
-                out[(0, c)] = m.fixed_view::<3, 1>(3, c).dot(&u);
+        (_, Basis::Full) => {
+            for (r, (off, u)) in ci.iter().enumerate().filter_map(|(r, x)| Some((r, (*x)?))) {
+                for c in 0..6 {
+                    out[(r, c)] = m.fixed_view::<3, 1>(off, c).dot(&u);
+                }
             }
         }
-        (Basis::Axis(u), Basis::Axis(w)) => {
-            out[(0, 0)] = u.dot(&(m.fixed_view::<3, 3>(3, 3) * w));
+        _ => {
+            for (r, (oi, u)) in ci.iter().enumerate().filter_map(|(r, x)| Some((r, (*x)?))) {
+                for (c, (oj, w)) in cj.iter().enumerate().filter_map(|(c, x)| Some((c, (*x)?))) {
+                    out[(r, c)] = u.dot(&(m.fixed_view::<3, 3>(oi, oj) * w));
+                }
+            }
         }
     }
     out

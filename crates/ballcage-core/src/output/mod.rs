@@ -40,14 +40,17 @@ pub fn schema(table: &TableDef, mut metadata: HashMap<String, String>) -> Schema
                 ColumnKind::F64 => DataType::Float64,
                 ColumnKind::OptU32 => DataType::UInt32,
                 ColumnKind::OptF64 => DataType::Float64,
-                ColumnKind::Name(_) => {
+                ColumnKind::Name(_) | ColumnKind::OptName(_) => {
                     DataType::Dictionary(Box::new(DataType::UInt32), Box::new(DataType::Utf8))
                 }
             };
             let mut md = HashMap::new();
             md.insert("unit".to_string(), c.unit.to_string());
             md.insert("description".to_string(), c.description.to_string());
-            let nullable = matches!(c.kind, ColumnKind::OptU32 | ColumnKind::OptF64);
+            let nullable = matches!(
+                c.kind,
+                ColumnKind::OptU32 | ColumnKind::OptF64 | ColumnKind::OptName(_)
+            );
             Field::new(c.name, dt, nullable).with_metadata(md)
         })
         .collect();
@@ -85,6 +88,15 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBa
         |names: &[String]| -> ArrayRef { Arc::new(StringArray::from_iter_values(names.iter())) };
     let bodies = dict_values(&rec.body_names);
     let pairs = dict_values(&rec.pair_names);
+    let parts: ArrayRef = Arc::new(StringArray::from_iter_values(rec.part_labels.iter()));
+    let labels = |dict: Dictionary| -> ArrayRef {
+        match dict {
+            Dictionary::Bodies => bodies.clone(),
+            Dictionary::Pairs => pairs.clone(),
+            Dictionary::Parts => parts.clone(),
+            Dictionary::Labels(labels) => Arc::new(StringArray::from_iter_values(labels.iter())),
+        }
+    };
     let mut out = Vec::with_capacity(rec.tables.len());
     for TableBuffer { def, data, .. } in rec.tables {
         let schema = Arc::new(schema(def, metadata.clone()));
@@ -100,18 +112,14 @@ pub fn record_batches(rec: Recording) -> Result<Vec<(&'static TableDef, RecordBa
                     (ColumnKind::OptU32, ColumnData::OptU32(v)) => Arc::new(UInt32Array::from(v)),
                     (ColumnKind::OptF64, ColumnData::OptF64(v)) => Arc::new(Float64Array::from(v)),
                     (ColumnKind::Name(dict), ColumnData::U32(v)) => {
-                        let values = match dict {
-                            Dictionary::Bodies => bodies.clone(),
-                            Dictionary::Pairs => pairs.clone(),
-                            Dictionary::Labels(labels) => {
-                                Arc::new(StringArray::from_iter_values(labels.iter()))
-                            }
-                        };
                         Arc::new(DictionaryArray::<UInt32Type>::try_new(
                             UInt32Array::from(v),
-                            values,
+                            labels(dict),
                         )?)
                     }
+                    (ColumnKind::OptName(dict), ColumnData::OptU32(v)) => Arc::new(
+                        DictionaryArray::<UInt32Type>::try_new(UInt32Array::from(v), labels(dict))?,
+                    ),
                     (k, _) => {
                         return Err(ArrowError::SchemaError(format!(
                             "column {} ({k:?}) has mismatched data",

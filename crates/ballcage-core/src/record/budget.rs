@@ -26,13 +26,15 @@ pub struct TableEstimate {
 
 impl TableDef {
     /// Bytes one row takes in the recorder's buffers: 8 per u64 or f64,
-    /// 4 per u32 or name, 8 per nullable u32 and 16 per nullable f64
+    /// 4 per u32 or name, 8 per nullable u32 or name and 16 per nullable f64
     /// (Rust's `Option` layout).
     pub fn row_bytes(&self) -> u64 {
         self.columns
             .iter()
             .map(|c| match c.kind {
-                ColumnKind::U64 | ColumnKind::F64 | ColumnKind::OptU32 => 8,
+                ColumnKind::U64 | ColumnKind::F64 | ColumnKind::OptU32 | ColumnKind::OptName(_) => {
+                    8
+                }
                 ColumnKind::U32 | ColumnKind::Name(_) => 4,
                 ColumnKind::OptF64 => 16,
             })
@@ -142,8 +144,9 @@ mod tests {
 
     #[test]
     fn row_bytes_counts_each_column_by_its_type() {
-        // bodies: step (u64), t (f64), body_id (u32), body (name), then 13 f64
-        assert_eq!(BODIES.row_bytes(), 8 + 8 + 4 + 4 + 13 * 8);
+        // bodies: step (u64), t (f64), body_id (u32), body (name), part
+        // (nullable name), link, hinge, key (nullable u32), then 13 f64
+        assert_eq!(BODIES.row_bytes(), 8 + 8 + 4 + 4 + 4 * 8 + 13 * 8);
         // contacts: step, t; pair_id, pair, body_a, body_b, point_index (u32/name); 13 f64
         assert_eq!(CONTACTS.row_bytes(), 8 + 8 + 5 * 4 + 13 * 8);
     }

@@ -6,7 +6,7 @@
 
 use std::ops::Range;
 
-use super::{Cell, Frame, Observer, Step, TableBuffer, contact_totals, table_def};
+use super::{BodyParts, Cell, Frame, Observer, Step, TableBuffer, contact_totals, table_def};
 use crate::dynamics::{ContactEval, Dynamics, Energy};
 use crate::model::{Model, State};
 use crate::scene::TableKind;
@@ -75,6 +75,9 @@ struct Dissipated {
     damping: f64,
     /// Taken by the penalty joints, stored and dissipated [J].
     joints: f64,
+    /// The joints' power [W] at the end of the last step, for the
+    /// trapezoidal rule (`None` before the first step).
+    joint_power: Option<f64>,
 }
 
 impl Dissipated {
@@ -82,20 +85,27 @@ impl Dissipated {
     fn add(&mut self, model: &Model, state: &State, evals: &[Vec<ContactEval>], h: f64) {
         for (pair, points) in model.pairs.iter().zip(evals) {
             for e in points {
-                // Adams and tanh friction oppose the slip: −F_t·v_slip = |F_t|·|v_slip|.
-                self.friction += e.tangential_force.norm() * e.slip_speed * h;
-                let elastic = pair.normal.elastic_force(e.point.depth);
+                // Adams and tanh friction oppose the slip: −F_t·v_slip = |F_t|·|v_slip|,
+                // times the point's weight (−1 at a level-set minimum, geometry::LineLaw).
+                self.friction += e.point.weight * e.tangential_force.norm() * e.slip_speed * h;
+                let elastic = e.point.weight * pair.normal.elastic_force(e.point.depth);
                 self.damping += (e.normal_force - elastic) * e.depth_rate * h;
             }
         }
+        // The joints' power swings with their stiff springs, so their work
+        // is integrated by the trapezoidal rule (second order in h: the
+        // balance of a conservative pipe then measures the integrator, not
+        // the quadrature; docs/model.md §8.5).
+        let mut power = 0.0;
         for j in &model.joints {
             let (w, ra, rb) = j.evaluate(state);
             let (wa, wb) = (state.omega_world(j.a), state.omega_world(j.b));
-            let power = w.force.dot(&(state.vel[j.b] + wb.cross(&rb))) + w.torque.dot(&wb)
+            power += w.force.dot(&(state.vel[j.b] + wb.cross(&rb))) + w.torque.dot(&wb)
                 - w.force.dot(&(state.vel[j.a] + wa.cross(&ra)))
                 - w.torque.dot(&wa);
-            self.joints -= power * h;
         }
+        let before = self.joint_power.replace(power).unwrap_or(power);
+        self.joints -= 0.5 * (before + power) * h;
     }
 }
 
@@ -114,6 +124,8 @@ pub struct Recorder {
     /// The engine's tables, the first `engine.len()` of `tables`.
     engine: Vec<TableKind>,
     observers: Vec<Registered>,
+    /// The bodies' part ids, from the first observer that has them.
+    parts: BodyParts,
     evals: Vec<Vec<ContactEval>>,
     /// Whether `evals` holds the current state's points (evaluated by
     /// [`Self::after_step`] for the step that a frame then records).
@@ -145,6 +157,10 @@ impl Recorder {
             || observers.iter().any(|o| o.needs_contacts());
         let needs_steps = model.record.tables.contains(&TableKind::Energy)
             || observers.iter().any(|o| o.needs_steps());
+        let parts = observers
+            .iter()
+            .find_map(|o| o.body_parts())
+            .unwrap_or_default();
         let observers = observers
             .into_iter()
             .map(|observer| {
@@ -160,6 +176,7 @@ impl Recorder {
             tables,
             engine,
             observers,
+            parts,
             evals: vec![Vec::new(); model.pairs.len()],
             evals_current: false,
             stats: vec![PairStats::default(); model.pairs.len()],
@@ -218,7 +235,7 @@ impl Recorder {
         let frame = (Cell::U64(step), Cell::F64(state.t));
         for (table, kind) in self.tables.iter_mut().zip(&self.engine) {
             match kind {
-                TableKind::Bodies => bodies(table, model, state, frame),
+                TableKind::Bodies => bodies(table, model, &self.parts, state, frame),
                 TableKind::Contacts => contacts(table, model, &self.evals, frame),
                 TableKind::Energy => {
                     let e = dynamics.energy(model, state);
@@ -244,6 +261,11 @@ impl Recorder {
         for r in &mut self.observers {
             r.observer.record(&view, &mut self.tables[r.tables.clone()]);
         }
+    }
+
+    /// Labels of the bodies' parts ([`BodyParts::labels`]).
+    pub fn part_labels(&self) -> &'static [&'static str] {
+        self.parts.labels
     }
 
     /// Writes the end-of-run rows (the summary, the observers') and hands
@@ -279,14 +301,25 @@ impl Recorder {
     }
 }
 
-fn bodies(table: &mut TableBuffer, model: &Model, s: &State, (step, t): (Cell, Cell)) {
+fn bodies(
+    table: &mut TableBuffer,
+    model: &Model,
+    parts: &BodyParts,
+    s: &State,
+    (step, t): (Cell, Cell),
+) {
     for &i in &model.record.bodies {
         let (p, q, v, w) = (s.pos[i], s.rot[i], s.vel[i], s.omega_world(i));
+        let ids = parts.of(i);
         table.push(&[
             step,
             t,
             Cell::U32(i as u32),
             Cell::U32(i as u32),
+            Cell::OptU32(ids.part),
+            Cell::OptU32(ids.link),
+            Cell::OptU32(ids.hinge),
+            Cell::OptU32(ids.key),
             Cell::F64(p.x),
             Cell::F64(p.y),
             Cell::F64(p.z),

@@ -14,7 +14,7 @@ mod observer;
 
 pub use budget::{TableEstimate, bytes_text, check_budget, estimate, frames};
 pub use frame::Recorder;
-pub use observer::{Frame, Observer, Step, contact_totals};
+pub use observer::{BodyParts, Frame, Observer, PartIds, Step, contact_totals};
 
 use crate::scene::TableKind;
 
@@ -35,6 +35,9 @@ pub enum ColumnKind {
     OptF64,
     /// A name, dictionary-encoded with u32 keys into a [`Dictionary`].
     Name(Dictionary),
+    /// A name as [`ColumnKind::Name`], or null where the column does not
+    /// apply to the row.
+    OptName(Dictionary),
 }
 
 /// Which list of names a name column indexes.
@@ -46,6 +49,9 @@ pub enum Dictionary {
     Pairs,
     /// A fixed list of labels, indexed by position.
     Labels(&'static [&'static str]),
+    /// The part labels of the layer that built the scene
+    /// ([`BodyParts::labels`], [`Recording::part_labels`]), indexed by position.
+    Parts,
 }
 
 /// One column: name, type, unit, meaning.
@@ -87,19 +93,45 @@ pub const fn col(
     }
 }
 
-use ColumnKind::{F64, Name, OptF64, OptU32, U32, U64};
+use ColumnKind::{F64, Name, OptF64, OptName, OptU32, U32, U64};
 
 /// The frame's integrator step index, first column of every per-frame table.
 pub const STEP: ColumnDef = col("step", U64, "", "integrator step index of the frame");
 /// The frame's simulated time, second column of every per-frame table.
 pub const TIME: ColumnDef = col("t", F64, "s", "simulated time");
 
-/// Columns of the `bodies` table: one row per recorded body per frame.
+/// Columns of the `bodies` table: one row per recorded body per frame. The
+/// part columns (`part` … `key`) are the ids a scene kind gives the bodies
+/// it builds ([`Observer::body_parts`]); null for a generic scene's bodies.
 const BODIES_COLUMNS: &[ColumnDef] = &[
     STEP,
     TIME,
     col("body_id", U32, "", "body index in the scene's body list"),
     col("body", Name(Dictionary::Bodies), "", "body name"),
+    col(
+        "part",
+        OptName(Dictionary::Parts),
+        "",
+        "what the body is in the assembly its scene kind built (e.g. link, key: the kind's labels); null for a body of a generic scene",
+    ),
+    col(
+        "link",
+        OptU32,
+        "",
+        "link number in the chain its scene kind built, 1 at the top (links; null otherwise)",
+    ),
+    col(
+        "hinge",
+        OptU32,
+        "",
+        "hinge number in that chain, 0 above link 1 (the parts inside a hinge: cage, ball keys; null otherwise)",
+    ),
+    col(
+        "key",
+        OptU32,
+        "",
+        "ball key number within its hinge, 0-5 (ball keys; null otherwise)",
+    ),
     col("pos_x", F64, "m", "centre-of-mass position x, world frame"),
     col("pos_y", F64, "m", "centre-of-mass position y, world frame"),
     col("pos_z", F64, "m", "centre-of-mass position z, world frame"),
@@ -175,7 +207,8 @@ const CONTACTS_COLUMNS: &[ColumnDef] = &[
         "normal_force",
         F64,
         "N",
-        "normal force magnitude (pushes b along the normal)",
+        "normal force along the normal on b (pushes b; negative at a depth minimum of the level-set \
+         line law, which takes back part of its neighbours' force: docs/model.md §4)",
     ),
     col(
         "tangential_force_x",
@@ -267,7 +300,7 @@ const ENERGY_COLUMNS: &[ColumnDef] = &[
         "load_work",
         F64,
         "J",
-        "work the applied torques have done since t = 0 (negative for a resisting moment)",
+        "work the applied torques and forces have done since t = 0 (negative for a resisting moment)",
     ),
     col(
         "friction_work",
@@ -390,7 +423,7 @@ pub enum Cell {
     U32(u32),
     /// For `F64` columns.
     F64(f64),
-    /// For `OptU32` columns.
+    /// For `OptU32` and `OptName` columns.
     OptU32(Option<u32>),
     /// For `OptF64` columns.
     OptF64(Option<f64>),
@@ -432,7 +465,7 @@ impl TableBuffer {
                 U64 => ColumnData::U64(Vec::new()),
                 U32 | Name(_) => ColumnData::U32(Vec::new()),
                 F64 => ColumnData::F64(Vec::new()),
-                OptU32 => ColumnData::OptU32(Vec::new()),
+                OptU32 | OptName(_) => ColumnData::OptU32(Vec::new()),
                 OptF64 => ColumnData::OptF64(Vec::new()),
             })
             .collect();
@@ -479,6 +512,8 @@ pub struct Recording {
     pub body_names: Vec<String>,
     /// Pair names by id.
     pub pair_names: Vec<String>,
+    /// Labels of the bodies' parts ([`Dictionary::Parts`]); empty for a generic scene.
+    pub part_labels: &'static [&'static str],
     /// Run metadata (key → value), written into the schema metadata.
     pub metadata: Vec<(String, String)>,
 }

@@ -45,6 +45,36 @@ pub struct Step<'a> {
     pub contacts: &'a [Vec<ContactEval>],
 }
 
+/// Where a body sits in the assembly a layer above the engine built: the
+/// `bodies` table's part columns. Ids that do not apply are `None`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PartIds {
+    /// What the body is: an index into [`BodyParts::labels`].
+    pub part: Option<u32>,
+    /// Link number in a chain.
+    pub link: Option<u32>,
+    /// Hinge number in a chain.
+    pub hinge: Option<u32>,
+    /// Ball key number within its hinge.
+    pub key: Option<u32>,
+}
+
+/// The parts of the bodies a layer built, for the `bodies` table.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct BodyParts {
+    /// Labels of [`PartIds::part`], indexed by it.
+    pub labels: &'static [&'static str],
+    /// Each body's ids, indexed by body id; bodies past its end have none.
+    pub ids: Vec<PartIds>,
+}
+
+impl BodyParts {
+    /// The ids of body `body` (all `None` for a body the layer did not describe).
+    pub fn of(&self, body: usize) -> PartIds {
+        self.ids.get(body).copied().unwrap_or_default()
+    }
+}
+
 /// A producer of output tables, registered with a simulation by a layer
 /// above the engine.
 pub trait Observer: Debug + Send + Sync {
@@ -74,6 +104,13 @@ pub trait Observer: Debug + Send + Sync {
     /// Appends the end-of-run rows at simulated time `end_time` [s]; `out`
     /// as in [`Self::record`]. Default: none.
     fn finish(&mut self, _model: &Model, _end_time: f64, _out: &mut [TableBuffer]) {}
+
+    /// The parts of the scene's bodies, for the `bodies` table's part
+    /// columns; the first observer that has them gives them. Default: none
+    /// (the columns are null).
+    fn body_parts(&self) -> Option<BodyParts> {
+        None
+    }
 
     /// A boxed copy (simulations are cloneable).
     fn clone_box(&self) -> Box<dyn Observer>;

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::fields::FieldDoc;
 use super::{Scene, direction, finite_vec, non_negative, positive};
 use crate::error::SceneError;
 
@@ -20,6 +21,10 @@ pub enum MotionKind {
     /// Dynamic, but free only to spin about `spin_axis` through its fixed
     /// centre of mass (a connector on a rotating pair).
     Spin,
+    /// Dynamic, free to spin about `spin_axis` and to slide along it (a
+    /// cylindrical joint to the ground: a connector whose centre of mass
+    /// moves only along the axis, e.g. to carry an axial force).
+    SpinSlide,
 }
 
 /// A body's shape, in its body frame.
@@ -88,6 +93,46 @@ pub enum TubeSegmentSpec {
 }
 
 impl ShapeSpec {
+    /// The unit and meaning of each field, of every shape type.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text(
+            "type",
+            "the shape: ball, cuboid, half-space, cylinder or tube",
+        ),
+        FieldDoc::number(
+            "radius",
+            "m",
+            "radius of a ball; outer radius of a cylinder",
+        ),
+        FieldDoc::number(
+            "half_extents",
+            "m",
+            "half-extents of a cuboid along the body x, y, z axes",
+        ),
+        FieldDoc::number(
+            "normal",
+            "-",
+            "outward normal of a half-space's boundary, body frame",
+        ),
+        FieldDoc::number("half_length", "m", "half of a cylinder's length"),
+        FieldDoc::number(
+            "inner_radius",
+            "m",
+            "bore radius of a cylinder (mass only); lumen radius of a tube",
+        ),
+        FieldDoc::number("start", "m", "a tube centreline's start point, body frame"),
+        FieldDoc::number(
+            "direction",
+            "-",
+            "a tube centreline's direction at its start, body frame",
+        ),
+        FieldDoc::tables(
+            "segments",
+            "a tube centreline's segments, in order from its start",
+            TubeSegmentSpec::FIELDS,
+        ),
+    ];
+
     /// Short name for messages.
     pub fn kind_name(&self) -> &'static str {
         match self {
@@ -196,6 +241,19 @@ impl ShapeSpec {
 }
 
 impl TubeSegmentSpec {
+    /// The unit and meaning of each field, of both segment types.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("type", "the segment: straight or arc"),
+        FieldDoc::number("length", "m", "length of a straight segment"),
+        FieldDoc::number("radius", "m", "centreline curvature radius of an arc"),
+        FieldDoc::number("angle_deg", "deg", "angle an arc turns"),
+        FieldDoc::number(
+            "bend",
+            "-",
+            "direction toward an arc's centre (its part across the current direction)",
+        ),
+    ];
+
     /// Checks lengths, radii and angles.
     fn validate(&self, p: &str) -> Result<(), SceneError> {
         match self {
@@ -263,7 +321,7 @@ pub struct BodySpec {
     #[serde(default, skip_serializing_if = "is_zero3")]
     pub angular_velocity: [f64; 3],
     /// Spin axis (world frame, through the centre of mass) for the
-    /// `kinematic-spin` and `spin` motions.
+    /// `kinematic-spin`, `spin` and `spin-slide` motions.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spin_axis: Option<[f64; 3]>,
     /// Final spin speed of a `kinematic-spin` body [rad/s], positive about `spin_axis`.
@@ -275,9 +333,68 @@ pub struct BodySpec {
 }
 
 impl BodySpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("name", "unique body name"),
+        FieldDoc::text(
+            "motion",
+            "how the body moves: fixed, dynamic, kinematic-spin, spin or spin-slide",
+        ),
+        FieldDoc::table(
+            "shape",
+            "shape in the body frame (principal axes, centred at the centre of mass)",
+            ShapeSpec::FIELDS,
+        ),
+        FieldDoc::number("mass", "kg", "mass; alternative to density"),
+        FieldDoc::number(
+            "density",
+            "kg/m³",
+            "density; mass and inertia follow from the shape",
+        ),
+        FieldDoc::number(
+            "inertia",
+            "kg·m²",
+            "principal moments of inertia about the body x, y, z axes",
+        ),
+        FieldDoc::number(
+            "position",
+            "m",
+            "initial position of the centre of mass, world frame",
+        ),
+        FieldDoc::number(
+            "orientation",
+            "-",
+            "initial orientation, unit quaternion [w, x, y, z], body to world",
+        ),
+        FieldDoc::number("velocity", "m/s", "initial velocity, world frame"),
+        FieldDoc::number(
+            "angular_velocity",
+            "rad/s",
+            "initial angular velocity, world frame",
+        ),
+        FieldDoc::number(
+            "spin_axis",
+            "-",
+            "spin axis through the centre of mass (kinematic-spin, spin and spin-slide motions), world frame",
+        ),
+        FieldDoc::number(
+            "spin_speed",
+            "rad/s",
+            "final spin speed of a kinematic-spin body about spin_axis",
+        ),
+        FieldDoc::number(
+            "spin_ramp",
+            "s",
+            "duration of the STEP ramp from rest to spin_speed",
+        ),
+    ];
+
     /// Whether the body carries integrated state.
     pub fn is_integrated(&self) -> bool {
-        matches!(self.motion, MotionKind::Dynamic | MotionKind::Spin)
+        matches!(
+            self.motion,
+            MotionKind::Dynamic | MotionKind::Spin | MotionKind::SpinSlide
+        )
     }
 
     /// Mass [kg] and principal inertia [kg·m²], for bodies that need them.
@@ -421,7 +538,7 @@ impl BodySpec {
             ));
         }
         match self.motion {
-            MotionKind::KinematicSpin | MotionKind::Spin => {
+            MotionKind::KinematicSpin | MotionKind::Spin | MotionKind::SpinSlide => {
                 let Some(axis) = &self.spin_axis else {
                     return Err(SceneError::new(
                         format!("{path}.spin_axis"),
@@ -436,7 +553,7 @@ impl BodySpec {
             _ if self.spin_axis.is_some() => Err(SceneError::new(
                 format!("{path}.spin_axis"),
                 format!("{:?}", self.spin_axis.unwrap_or_default()),
-                "only `kinematic-spin` and `spin` bodies take a spin axis",
+                "only `kinematic-spin`, `spin` and `spin-slide` bodies take a spin axis",
             )),
             // NaN != 0 too: a stray value is refused, not kept in the scene unused
             _ if self.spin_speed != 0.0 || self.spin_ramp != 0.0 => Err(SceneError::new(
@@ -453,7 +570,7 @@ impl BodySpec {
                 } else {
                     self.spin_ramp
                 },
-                "only `kinematic-spin` and `spin` bodies take a spin speed and ramp",
+                "only `kinematic-spin`, `spin` and `spin-slide` bodies take a spin speed and ramp",
             )),
             _ => Ok(()),
         }

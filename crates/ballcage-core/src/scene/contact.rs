@@ -4,6 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::fields::{FieldDoc, FieldInfo};
 use super::{Scene, direction, finite_vec, non_negative, positive};
 use crate::error::SceneError;
 
@@ -18,6 +19,119 @@ pub enum FieldUnits {
     /// N·s/mm, lengths mm, speeds mm/s. Converted to SI once, at assembly.
     #[serde(rename = "N-mm-s")]
     NMmS,
+}
+
+impl FieldUnits {
+    /// Millimetres per length unit.
+    fn millimetres(self) -> f64 {
+        match self {
+            Self::Si => 1000.0,
+            Self::NMmS => 1.0,
+        }
+    }
+}
+
+/// The fields of the contact laws (normal and friction). Their units are
+/// written for the law's own `units`: `{L}` is its length (m or mm) and
+/// `^n` its stiffness exponent ([`law_field`]).
+pub const LAW_FIELDS: &[FieldDoc] = &[
+    FieldDoc::text(
+        "law",
+        "the law: impact, lankarani-nikravesh, hunt-crossley, flores, hertz or linear (normal); adams or tanh (friction)",
+    ),
+    FieldDoc::text(
+        "units",
+        "the units the law's fields are written in: SI, or N-mm-s (the paper's)",
+    ),
+    FieldDoc::number(
+        "stiffness",
+        "N/{L}^n",
+        "stiffness K of the elastic force K·δⁿ",
+    ),
+    FieldDoc::number("exponent", "-", "force exponent n"),
+    FieldDoc::number(
+        "damping",
+        "N·s/{L}",
+        "damping: IMPACT's c_max, or the linear law's c",
+    ),
+    FieldDoc::number(
+        "depth_max",
+        "{L}",
+        "IMPACT's d_max, the depth of full damping",
+    ),
+    FieldDoc::number("restitution", "-", "coefficient of restitution e"),
+    FieldDoc::number(
+        "min_approach_speed",
+        "{L}/s",
+        "lower clamp of the approach speed latched at contact onset",
+    ),
+    FieldDoc::number("mu_static", "-", "static friction coefficient μs"),
+    FieldDoc::number("mu_dynamic", "-", "dynamic friction coefficient μd"),
+    FieldDoc::number("v_static", "{L}/s", "stiction transition speed v_s"),
+    FieldDoc::number(
+        "v_dynamic",
+        "{L}/s",
+        "friction transition speed v_d, above v_static",
+    ),
+    FieldDoc::number("mu", "-", "friction coefficient μ"),
+    FieldDoc::number("v_ref", "{L}/s", "regularization speed"),
+];
+
+/// A law table's `units` and stiffness exponent n: `exponent`, else 1.5
+/// for `hertz` and 1 for the others (`linear`; friction has no stiffness).
+fn law_units(law: &toml::Table) -> Option<(FieldUnits, f64)> {
+    let units: FieldUnits = law
+        .get("units")
+        .and_then(|u| u.clone().try_into().ok())
+        .unwrap_or_default();
+    let n = match (
+        law.get("law").and_then(toml::Value::as_str),
+        law.get("exponent"),
+    ) {
+        (_, Some(n)) => n.as_float().or_else(|| n.as_integer().map(|i| i as f64))?,
+        (Some("hertz"), None) => 1.5,
+        _ => 1.0,
+    };
+    Some((units, n))
+}
+
+/// The unit and meaning of field `key` of the contact law table `law`
+/// ([`LAW_FIELDS`]): lengths in the law's `units`, a stiffness in N/m^n
+/// (or N/mm^n) for its exponent n, `N/m` for n = 1. A [`LawRule`](super::LawRule).
+pub fn law_field(key: &str, law: &toml::Table) -> Option<FieldInfo> {
+    let doc = LAW_FIELDS.iter().find(|d| d.key == key)?;
+    let (units, n) = law_units(law)?;
+    let length = match units {
+        FieldUnits::Si => "m",
+        FieldUnits::NMmS => "mm",
+    };
+    let power = if n == 1.0 {
+        String::new()
+    } else {
+        format!("^{n}")
+    };
+    Some(FieldInfo {
+        unit: doc.unit.replace("^n", &power).replace("{L}", length),
+        meaning: doc.meaning,
+    })
+}
+
+/// The factor that turns a value of field `key` of the contact law table
+/// `law`, written in `from` units, into the law's own units (those
+/// [`law_field`] names): (mm per own length / mm per `from` length)^n for
+/// a stiffness, that ratio for a damping, its inverse for a length or a
+/// speed, 1 for a pure number; `None` for a field that is not a number.
+pub fn scale_from(key: &str, law: &toml::Table, from: FieldUnits) -> Option<f64> {
+    let doc = LAW_FIELDS.iter().find(|d| d.key == key)?;
+    let (units, n) = law_units(law)?;
+    let ratio = units.millimetres() / from.millimetres();
+    match doc.unit {
+        "-" => Some(1.0),
+        u if u.ends_with("^n") => Some(ratio.powf(n)),
+        u if u.starts_with("N·s/") => Some(ratio),
+        u if u.starts_with("{L}") => Some(from.millimetres() / units.millimetres()),
+        _ => None,
+    }
 }
 
 fn default_exponent_hertzian() -> f64 {
@@ -327,6 +441,66 @@ pub enum FeatureSpec {
 }
 
 impl FeatureSpec {
+    /// The unit and meaning of each field, of every geometry type.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text(
+            "type",
+            "the geometry: torus-ball, slot-ball, cavity-sphere or ring-cylinder",
+        ),
+        FieldDoc::number(
+            "centre",
+            "m",
+            "core-circle centre (torus-ball) or mid-plane point (slot-ball), body a frame",
+        ),
+        FieldDoc::number(
+            "axis",
+            "-",
+            "normal of the core circle's plane (torus-ball), body a frame",
+        ),
+        FieldDoc::number("core_radius", "m", "radius of the torus' core circle"),
+        FieldDoc::number(
+            "tube_radius",
+            "m",
+            "radius of the torus' section, larger than the ball's",
+        ),
+        FieldDoc::number("normal", "-", "normal of a slot's planes, body a frame"),
+        FieldDoc::number("half_width", "m", "half of the gap between a slot's planes"),
+        FieldDoc::number(
+            "cavity_centre",
+            "m",
+            "centre of the spherical cavity, body a frame",
+        ),
+        FieldDoc::number("cavity_radius", "m", "radius of the spherical cavity"),
+        FieldDoc::number(
+            "sphere_centre",
+            "m",
+            "centre of the sphere in the cavity, body b frame",
+        ),
+        FieldDoc::number(
+            "sphere_radius",
+            "m",
+            "radius of the sphere in the cavity, smaller than the cavity's",
+        ),
+        FieldDoc::number("ring_centre", "m", "centre of the ring, body a frame"),
+        FieldDoc::number("ring_axis", "-", "normal of the ring's plane, body a frame"),
+        FieldDoc::number("ring_radius", "m", "radius of the ring"),
+        FieldDoc::number(
+            "axis_point",
+            "m",
+            "a point of the cylinder's axis, body b frame",
+        ),
+        FieldDoc::number(
+            "axis_direction",
+            "-",
+            "direction of the cylinder's axis, body b frame",
+        ),
+        FieldDoc::number(
+            "cylinder_radius",
+            "m",
+            "radius of the cylinder through the ring, smaller than the ring's",
+        ),
+    ];
+
     /// Checks the feature's own dimensions; whether it fits the pair's
     /// shapes is checked at assembly.
     pub fn validate(&self, g: &str) -> Result<(), SceneError> {
@@ -422,13 +596,55 @@ pub struct ContactSpec {
     /// both end rims and evenly spaced interior points).
     #[serde(default = "default_points")]
     pub points: u32,
+    /// How a cylinder–tube line contact becomes points (other pairs ignore
+    /// it): `"level-sets"` (default) or `"patches"` (docs/model.md §4).
+    #[serde(default)]
+    pub line_law: LineLawSpec,
 }
 
 fn default_points() -> u32 {
     5
 }
 
+/// How a cylinder–tube pair turns its line contact into point laws
+/// (docs/model.md §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LineLawSpec {
+    /// The point law at every depth maximum minus the point law at every
+    /// interior depth minimum: continuous in the pose, the gradient of an
+    /// energy, independent of the sample count.
+    #[default]
+    LevelSets,
+    /// One point law per contact patch at its deepest point, acting at the
+    /// patch's sampled centroid (MSC Adams' solid contact; jumps when
+    /// patches merge or split). For comparison.
+    Patches,
+}
+
 impl ContactSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("name", "pair name in the output; default \"<a>/<b>\""),
+        FieldDoc::text("bodies", "the two bodies [a, b]; normals point from a to b"),
+        FieldDoc::law("normal", "normal force law", law_field),
+        FieldDoc::law("friction", "friction law; none: frictionless", law_field),
+        FieldDoc::table(
+            "geometry",
+            "explicit contact geometry; none: the bodies' shapes decide",
+            FeatureSpec::FIELDS,
+        ),
+        FieldDoc::number(
+            "points",
+            "-",
+            "sample points along a cylinder's axis for cylinder-tube contact",
+        ),
+        FieldDoc::text(
+            "line_law",
+            "cylinder-tube line contact as points: level-sets (continuous) or patches (Adams, jumps)",
+        ),
+    ];
+
     /// The pair's name in outputs.
     pub fn pair_name(&self) -> String {
         self.name

@@ -2,6 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::fields::FieldDoc;
 use super::{Scene, finite_vec, non_negative, positive};
 use crate::error::SceneError;
 
@@ -33,6 +34,18 @@ pub enum JointSpec {
 }
 
 impl JointSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("type", "the joint: cv (ideal constant-velocity)"),
+        FieldDoc::text("name", "name in messages"),
+        FieldDoc::text("bodies", "the two bodies [a, b]"),
+        FieldDoc::number("anchors", "m", "hinge point in each body's frame"),
+        FieldDoc::number("stiffness", "N/m", "hinge-point spring"),
+        FieldDoc::number("damping", "N·s/m", "hinge-point damper"),
+        FieldDoc::number("twist_stiffness", "N·m/rad", "twist spring"),
+        FieldDoc::number("twist_damping", "N·m·s/rad", "twist damper"),
+    ];
+
     /// The two bodies `[a, b]`.
     pub fn bodies(&self) -> &[String; 2] {
         match self {

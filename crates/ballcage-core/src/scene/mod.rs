@@ -9,13 +9,18 @@
 
 mod body;
 mod contact;
+mod fields;
 mod joint;
 mod load;
 mod overrides;
 mod suggest;
 
 pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
-pub use contact::{ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, NormalLawSpec};
+pub use contact::{
+    ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, LineLawSpec, NormalLawSpec, law_field,
+    scale_from,
+};
+pub use fields::{FieldDoc, FieldInfo, Fields, LawRule, annotate, describe, flatten, numeric_keys};
 pub use joint::JointSpec;
 pub use load::LoadSpec;
 pub use overrides::{apply_override, lookup};
@@ -166,6 +171,32 @@ pub enum LinearSolver {
     SparseLu,
 }
 
+impl NewtonSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number(
+            "tolerance",
+            "-",
+            "convergence tolerance on the velocity-twist increments, relative to |v| + 1 m/s",
+        ),
+        FieldDoc::number("max_iterations", "-", "Newton iterations allowed per stage"),
+        FieldDoc::text(
+            "reuse_jacobian",
+            "keep the factorized Jacobian from step to step while Newton converges fast",
+        ),
+        FieldDoc::number(
+            "reuse_iterations",
+            "-",
+            "iterations per stage within which the Jacobian is kept",
+        ),
+        FieldDoc::text(
+            "fallback",
+            "take a failing h/16 part step with the linearly implicit Euler step instead of stopping",
+        ),
+        FieldDoc::text("linear_solver", "the implicit steps' linear solver"),
+    ];
+}
+
 impl Default for NewtonSpec {
     fn default() -> Self {
         Self {
@@ -202,6 +233,27 @@ pub struct DivergenceSpec {
     /// while a stable explicit run near its step limit (symplectic Euler's
     /// energy swings by up to 1/(1 − (hω/2)²)) does not.
     pub energy_growth: f64,
+}
+
+impl DivergenceSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number(
+            "penetration_fraction",
+            "-",
+            "largest allowed penetration, as a fraction of the pair's smallest contacting radius",
+        ),
+        FieldDoc::number(
+            "max_penetration",
+            "m",
+            "largest allowed penetration, for every pair (replaces penetration_fraction)",
+        ),
+        FieldDoc::number(
+            "energy_growth",
+            "-",
+            "largest energy the integrator may create, as a fraction of the system's energy scale",
+        ),
+    ];
 }
 
 impl Default for DivergenceSpec {
@@ -244,6 +296,36 @@ pub struct SimulationSpec {
     /// a typo in the duration). Raise it to run longer. Default 1e8.
     #[serde(default = "default_max_steps")]
     pub max_steps: u64,
+}
+
+impl SimulationSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::number("duration", "s", "simulated duration"),
+        FieldDoc::number("dt", "s", "integrator step"),
+        FieldDoc::number(
+            "output_interval",
+            "s",
+            "interval between recorded frames, a whole multiple of dt",
+        ),
+        FieldDoc::text("integrator", "the fixed-step integrator"),
+        FieldDoc::table(
+            "newton",
+            "Newton iterations of the sdirk2 integrator",
+            NewtonSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "divergence",
+            "when a run is stopped as diverged",
+            DivergenceSpec::FIELDS,
+        ),
+        FieldDoc::number(
+            "threads",
+            "-",
+            "threads that evaluate the contact pairs in parallel (0: one per core)",
+        ),
+        FieldDoc::number("max_steps", "-", "most integrator steps a run may take"),
+    ];
 }
 
 /// Most threads `simulation.threads` may ask for: each simulation starts
@@ -337,6 +419,15 @@ pub struct WorldSpec {
     pub gravity: [f64; 3],
 }
 
+impl WorldSpec {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[FieldDoc::number(
+        "gravity",
+        "m/s²",
+        "gravitational acceleration, world frame",
+    )];
+}
+
 impl Default for WorldSpec {
     fn default() -> Self {
         Self { gravity: [0.0; 3] }
@@ -423,6 +514,25 @@ pub(crate) fn default_max_bytes() -> u64 {
 }
 
 impl<T: TableChoice> RecordSpec<T> {
+    /// The unit and meaning of each field.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text("tables", "tables to produce"),
+        FieldDoc::text(
+            "bodies",
+            "bodies recorded in the bodies table; empty: every non-fixed body",
+        ),
+        FieldDoc::text(
+            "contacts",
+            "contact pairs recorded in the contacts table; empty: every pair",
+        ),
+        FieldDoc::number(
+            "summary_window",
+            "s",
+            "time window [start, end] of the summary table; empty: the whole run",
+        ),
+        FieldDoc::number("max_bytes", "B", "most memory the recorded tables may take"),
+    ];
+
     /// Checks the table list and the summary window against the run's
     /// `duration` [s] (not the names, which need the scene: [`Scene::validate`]).
     pub fn validate_tables(&self, duration: f64) -> Result<(), SceneError> {
@@ -538,6 +648,29 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// The unit and meaning of every field of a generic scene document.
+    pub const FIELDS: &'static [FieldDoc] = &[
+        FieldDoc::text(
+            "name",
+            "free-form scene name, copied into the output metadata",
+        ),
+        FieldDoc::table("simulation", "time stepping", SimulationSpec::FIELDS),
+        FieldDoc::table("world", "gravity", WorldSpec::FIELDS),
+        FieldDoc::table("record", "what to record", RecordSpec::<TableKind>::FIELDS),
+        FieldDoc::tables(
+            "bodies",
+            "bodies, in order; the order fixes body ids",
+            BodySpec::FIELDS,
+        ),
+        FieldDoc::tables(
+            "contacts",
+            "declared contact pairs; no other pair is ever tested",
+            ContactSpec::FIELDS,
+        ),
+        FieldDoc::tables("loads", "applied loads", LoadSpec::FIELDS),
+        FieldDoc::tables("joints", "penalty joints", JointSpec::FIELDS),
+    ];
+
     /// Parses a generic scene from TOML text, applies `dotted.key=value`
     /// overrides, and validates. Documents that may be of another kind (a
     /// `kind` key) are read by the loader, a layer above.

@@ -4,7 +4,7 @@ use crate::error::SceneError;
 
 /// The parts of a dotted key; a list element may be written `bodies.1.mass`
 /// or, as error messages print paths, `bodies[1].mass`.
-fn key_parts(key: &str) -> Vec<String> {
+pub(crate) fn key_parts(key: &str) -> Vec<String> {
     key.trim()
         .replace('[', ".")
         .replace(']', "")

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ballcage._native import InputError
-from ballcage.paper.frames import frame_grid, frame_times
+from ballcage.measures.frames import frame_grid, frame_times
 from ballcage.run import Run
 
 __all__ = ["PHASES", "Phase", "SceneFacts", "phases", "scene_facts"]
@@ -56,14 +56,18 @@ def scene_facts(run: Run) -> SceneFacts:
 
 @dataclass(frozen=True)
 class Phase:
-    """One of Table 3's phases found in a run, with its most deformed link."""
+    """One of Table 3's phases found in a run, and the link whose centre is furthest out there.
+
+    The most deformed joint is not chosen per phase (the furthest centre is an
+    argmax over links that all sit near the clearance) but over the last
+    revolution: `ballcage.measures.shape.rank_bends`.
+    """
 
     label: str
     t: float
     frame: int
-    most_deformed: int  # link number
-    included_angle: float  # deg
-    offset_mm: float
+    furthest: int  # link whose centre is furthest from the tube centreline (largest links.radial_offset)
+    furthest_offset_mm: float  # its centre offset [mm]
 
 
 def phases(run: Run, facts: SceneFacts) -> tuple[list[Phase], list[str]]:
@@ -72,7 +76,7 @@ def phases(run: Run, facts: SceneFacts) -> tuple[list[Phase], list[str]]:
     times = frame_times(run)
     if links is None or links.num_rows == 0 or len(times) == 0:
         return [], list(PHASES)
-    by_link = frame_grid(links, times, ["link"], ["radial_offset", "included_angle_deg"])
+    by_link = frame_grid(links, times, ["link"], ["radial_offset"])
     tol = max(facts.output_interval, 1e-9) * 0.5 + 1e-9
     found, skipped = [], []
     for label, t in facts.phase_times():
@@ -85,7 +89,5 @@ def phases(run: Run, facts: SceneFacts) -> tuple[list[Phase], list[str]]:
             continue
         offsets = by_link["radial_offset"][f, 1:]
         k = int(np.nanargmax(offsets)) + 1
-        found.append(
-            Phase(label, float(times[f]), f, k, float(by_link["included_angle_deg"][f, k]), 1e3 * float(offsets[k - 1]))
-        )
+        found.append(Phase(label, float(times[f]), f, k, 1e3 * float(offsets[k - 1])))
     return found, skipped

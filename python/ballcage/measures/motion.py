@@ -1,63 +1,28 @@
-"""Table 3's motion of a link, as the paper defines it: the most deformed joint and its range of motion.
+"""Table 3's range of motion of a link: its centre's path in the tube cross-section over the last revolution.
 
-Pure helpers on numpy data (`most_frequent`, `peak_to_peak`, `largest_offset`)
-and the runs' side of them (`last_revolution`, `centre_paths`).
+Pure helpers on numpy data (`peak_to_peak`, `largest_offset`) and the runs'
+side of them (`last_revolution`, `centre_paths`). The most deformed joint,
+whose range of motion Table 3 gives, is chosen in `ballcage.measures.shape`.
 """
 
 from __future__ import annotations
 
 import math
-from collections import Counter
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from ballcage._native import InputError
-from ballcage.paper.facts import SceneFacts
-from ballcage.paper.frames import frame_grid, frame_times
+from ballcage.measures.phases import SceneFacts
+from ballcage.measures.frames import frame_grid, frame_times
 from ballcage.run import Run
 
 __all__ = [
     "CentrePaths",
-    "MostFrequent",
     "centre_paths",
     "largest_offset",
     "last_revolution",
-    "most_frequent",
     "peak_to_peak",
 ]
-
-
-@dataclass(frozen=True)
-class MostFrequent:
-    """The most frequent link of the phases, and whether a tie had to be broken."""
-
-    link: int
-    count: int  # phases at which `link` is the most deformed
-    tied: tuple[int, ...]  # every link with `count` phases, ascending (one link: no tie)
-
-    @property
-    def tie(self) -> bool:
-        return len(self.tied) > 1
-
-
-def most_frequent(links: Sequence[int], deformation: Sequence[float]) -> MostFrequent:
-    """The link most often the most deformed over the phases (never a mean of link numbers).
-
-    `links[i]` is the most deformed link at phase i and `deformation[i]` its
-    deformation there (any unit, e.g. the centre offset [m]). A tie between
-    links of equal count goes to the one with the largest deformation at any
-    of its phases (then to the lower link number). `ValueError` on no phases.
-    """
-    if len(links) == 0 or len(links) != len(deformation):
-        raise InputError(f"need one deformation per phase, got {len(links)} links and {len(deformation)} values")
-    counts = Counter(int(k) for k in links)
-    top = max(counts.values())
-    tied = tuple(sorted(k for k, c in counts.items() if c == top))
-    largest = {k: max(float(d) for kk, d in zip(links, deformation, strict=True) if int(kk) == k) for k in tied}
-    link = max(tied, key=lambda k: (largest[k], -k))
-    return MostFrequent(link, top, tied)
 
 
 def _hull(points: np.ndarray) -> np.ndarray:

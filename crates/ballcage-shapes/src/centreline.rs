@@ -1,0 +1,23 @@
+//! A lumen around a centreline: what the line contact (module `line`)
+//! walks along, and what the tube and the groove are. They name this
+//! module, and the tube never names the line contact.
+
+use parry3d_f64::math::Vector;
+
+/// The nearest centreline point to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CentrelinePoint {
+    /// Point on the centreline [m], tube frame.
+    pub point: Vector,
+    /// Unit tangent there.
+    pub tangent: Vector,
+}
+
+/// A lumen around a centreline: the wall is `wall_radius` from it.
+pub trait Centreline {
+    /// Nearest centreline point to `q`, or `None` where there is no wall
+    /// (past an open end, or on a torus's axis).
+    fn nearest(&self, q: Vector) -> Option<CentrelinePoint>;
+    /// Distance from the centreline to the wall [m].
+    fn wall_radius(&self) -> f64;
+}
