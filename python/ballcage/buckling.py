@@ -14,8 +14,12 @@ the arc at any torque. `buckling` gives the torque at which the hinge with the
 largest such drive swings 1 rad about the chord of its neighbours against
 what can hold it (§3): gravity on its two links (a pendulum), a joint bending
 stiffness and a hinge friction moment, and, for longer chains, the discrete
-Greenhill torque of a bending stiffness with axial tension. Everything is SI:
-torques in N·m, forces in N, lengths in m, stiffness in N·m/rad.
+Greenhill torque of a bending stiffness with axial tension (the scene's
+``load.axial_force`` when its lower end is axially free). With the paper's
+fixed lower end, the hinges' axial play is the only length the global mode
+can coil into: `Buckling.play_excursion` is how far off the axis that lets it
+go (docs/buckling.md §3a). Everything is SI: torques in N·m, forces in N,
+lengths in m, stiffness in N·m/rad.
 
     >>> import ballcage
     >>> b = ballcage.buckling()                        # the paper's scene
@@ -39,7 +43,15 @@ from typing import Any
 from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene, load_scene
 
-__all__ = ["Buckling", "HingeDrive", "SimulatedTorque", "buckling", "end_wall_force", "simulate_check"]
+__all__ = [
+    "Buckling",
+    "HingeDrive",
+    "SimulatedTorque",
+    "buckling",
+    "end_wall_force",
+    "play_excursion",
+    "simulate_check",
+]
 
 #: Swing about the chord of its neighbours [rad] at which a hinge counts as having left the arc.
 LEFT_AT_SWING = 1.0
@@ -79,11 +91,16 @@ class Buckling:
     bends: tuple[float, ...]
     #: The terms, SI with the unit in the key.
     terms: dict[str, float] = field(default_factory=dict)
+    #: Largest hinge offset from the tube's axis [m] the global (Greenhill) mode reaches when it
+    #: takes up the hinges' play: the quarter-turn helix through the end hinges whose excess length is
+    #: (n + 1)·play (eq. 3.8). ``inf`` with an axially free lower end, which lets it coil freely.
+    play_excursion: float = math.inf
 
     def __str__(self) -> str:
         rows = [f"threshold torque          {self.threshold:12.4g} N·m  ({self.mode})"]
         rows += [f"{k:<26}{v:12.4g}" for k, v in self.terms.items()]
         rows.append(f"Greenhill torque          {self.greenhill:12.4g} N·m")
+        rows.append(f"play excursion            {self.play_excursion:12.4g} m")
         rows.append("hinge  bend [deg]  D_k [1]     W_k/T [1/m]  swing radius [mm]  g across [m/s²]  T_c [N·m]")
         pitch = self.terms["pitch [m]"]
         for h in self.hinges:
@@ -112,7 +129,8 @@ def buckling(
     *,
     friction_moment: float = 0.0,
     bending_stiffness: float = 0.0,
-    axial_tension: float = 0.0,
+    axial_tension: float | None = None,
+    hinge_play: float = 0.0,
     overrides: Iterable[str] = (),
 ) -> Buckling:
     """The torque [N·m] above which a drill-pipe scene's chain leaves the arc of its tube.
@@ -121,15 +139,21 @@ def buckling(
     `overrides` ``dotted.key=value`` strings. The stabilising terms the scene does not
     model are given here: `friction_moment` M_f [N·m], a static friction moment each
     hinge opposes to bending; `bending_stiffness` k_b [N·m/rad] of each hinge;
-    `axial_tension` N [N] along the chain (compression negative). Gravity and the
-    link mass come from the scene. Raises `ValueError` naming a bad term or a scene
-    that is not a drill pipe, and `ballcage.SceneError` for an invalid scene.
+    `axial_tension` N [N] along the chain (compression negative; default: the scene's
+    ``load.axial_force`` with ``pipe.lower_end = "axially-free"``, else 0); `hinge_play`
+    [m], each hinge's axial play, which a fixed lower end leaves as the only length the
+    global mode can take up (`Buckling.play_excursion`). Gravity and the link mass come
+    from the scene. Raises `ValueError` naming a bad term or a scene that is not a drill
+    pipe, and `ballcage.SceneError` for an invalid scene.
     """
-    _check_terms(friction_moment, bending_stiffness, axial_tension)
     patches = list(overrides)
     s = default_scene(patches) if scene is None else load_scene(scene, patches)
     if s.kind != "drill-pipe":
         raise InputError(f"scene kind = {s.kind!r}: buckling needs a drill-pipe scene (kind = \"drill-pipe\")")
+    free_end = s.value("pipe.lower_end") == "axially-free"
+    if axial_tension is None:
+        axial_tension = float(s.value("load.axial_force")) if free_end else 0.0
+    _check_terms(friction_moment, bending_stiffness, axial_tension, hinge_play)
     pitch, n = float(s.value("pipe.pitch")), int(s.value("pipe.joints"))
     placed = s.placed_chain()
     # Link 1's mass as built (the ideal-CV links carry their hinges' cage and keys).
@@ -155,8 +179,24 @@ def buckling(
         "friction moment [N·m]": friction_moment,
         "bending stiffness [N·m/rad]": bending_stiffness,
         "axial tension [N]": axial_tension,
+        "hinge play [m]": hinge_play,
+        "lower end axially free": float(free_end),
     }
-    return Buckling(threshold, mode, hinges, greenhill, bends, terms)
+    excursion = math.inf if free_end else play_excursion(n, pitch, hinge_play)
+    return Buckling(threshold, mode, hinges, greenhill, bends, terms, excursion)
+
+
+def play_excursion(links: int, pitch: float, play: float) -> float:
+    """Largest hinge offset [m] of the global mode that the hinges' axial `play` [m] each allows.
+
+    A chain of `links` links of `pitch` l [m] between two held ends has n + 1 hinges, so
+    (n + 1)·play of excess length. The Greenhill mode of a chain under torque and tension is
+    a helix of a quarter turn per link (eq. 3.7, θ = π/2); through the two end hinges it is
+    w_k = a·(e^{iθk} − 1), whose links each lose 2a²·sin²(θ/2)/l = a²/l of axial length.
+    Taking up the excess: a = √((n + 1)·play·l/n), and the hinges reach 2a off the axis
+    (docs/buckling.md eq. 3.8).
+    """
+    return 2.0 * math.sqrt((links + 1) * play * pitch / links)
 
 
 @dataclass(frozen=True)
@@ -237,11 +277,15 @@ def _observe(torque: float, links: Any, hinges: Any, since: float) -> SimulatedT
     )
 
 
-def _check_terms(friction_moment: float, bending_stiffness: float, axial_tension: float) -> None:
-    resistances = (("friction_moment", friction_moment, "N·m"), ("bending_stiffness", bending_stiffness, "N·m/rad"))
-    for name, value, unit in resistances:
+def _check_terms(friction_moment: float, bending_stiffness: float, axial_tension: float, hinge_play: float) -> None:
+    resistances = (
+        ("friction_moment", friction_moment, "N·m", "a resistance, not a drive"),
+        ("bending_stiffness", bending_stiffness, "N·m/rad", "a resistance, not a drive"),
+        ("hinge_play", hinge_play, "m", "a clearance"),
+    )
+    for name, value, unit, what in resistances:
         if not (math.isfinite(value) and value >= 0.0):
-            raise InputError(f"{name} = {value} {unit}: must be a finite number ≥ 0 (a resistance, not a drive)")
+            raise InputError(f"{name} = {value} {unit}: must be a finite number ≥ 0 ({what})")
     if not math.isfinite(axial_tension):
         raise InputError(f"axial_tension = {axial_tension} N: must be finite (tension positive, compression negative)")
 

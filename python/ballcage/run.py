@@ -75,6 +75,26 @@ class Run:
         return {}
 
     @property
+    def fallback_note(self) -> str | None:
+        """One sentence when the implicit integrator took part steps by its first-order fallback, else ``None``.
+
+        SDIRK2 retries a step Newton cannot solve in halves, down to h/16, and takes a part step that still
+        fails by the linearly implicit Euler step (``simulation.newton.fallback``): first order in the step,
+        so the run is less accurate there than its step says. The count is ``ballcage.fallback_steps``,
+        the smallest part step ``ballcage.smallest_step_s``.
+        """
+        meta = self.metadata
+        count = int(meta.get("ballcage.fallback_steps", "0"))
+        if count == 0:
+            return None
+        smallest = float(meta.get("ballcage.smallest_step_s", "nan"))
+        return (
+            f"{count} part step{'s' if count != 1 else ''} of {smallest:.3g} s were taken by the first-order "
+            "fallback (linearly implicit Euler) where Newton did not converge: the run is less accurate there "
+            "than its step says (docs/accuracy.md)"
+        )
+
+    @property
     def complete(self) -> bool:
         """Whether the run reached the scene's duration (``ballcage.complete`` in the metadata)."""
         if self.error is not None:

@@ -310,6 +310,13 @@ impl Simulation {
                 stats.fallbacks.to_string(),
             ),
             (
+                "ballcage.smallest_step_s".to_string(),
+                format!(
+                    "{:e}",
+                    self.model.dt / f64::from(1u32 << stats.deepest_halving)
+                ),
+            ),
+            (
                 "ballcage.wall_time_s".to_string(),
                 format!("{:.6}", self.wall.as_secs_f64()),
             ),

@@ -1,6 +1,6 @@
 //! The chain's end restraint (issue 25, item 2): an axially free lower
 //! connector (`pipe.lower_end = "axially-free"`) carrying `load.axial_force`,
-//! against hand calculations (docs/model.md §4, "Connectors").
+//! against hand calculations (docs/paper.md, "The chain's end restraint").
 
 use ballcage_core::Document;
 use ballcage_core::math::Vec3;

@@ -79,9 +79,19 @@ friction = {{ law = "tanh", mu = 0.3, v_ref = 1e-4 }}
     assert!(error.abs() < 1e-3 * expected, "balance error {error} J");
 }
 
-/// The paper's drive: input work = output work + friction + damping + the
-/// change of kinetic, gravitational and elastic energy, within 1 % of the
-/// input (issue 15), for both hinge models.
+/// The paper's drive: input work = output work + friction + damping + joint
+/// work + the change of kinetic, gravitational and elastic energy (issue
+/// 15), for both hinge models, over 0.4 s.
+///
+/// The balance is checked to a tenth of the smallest term it includes, so
+/// that leaving out or mis-signing any one of them fails by at least ten
+/// times the tolerance. Measured (2026-11-26): ball keys, input 4455 J,
+/// output 3606, ΔE 395, friction 443, damping 11.4 (0.26 % of the input,
+/// the smallest: tolerance 1.1 J), joint work 0 (the hinges have no penalty
+/// joints), balance error −0.10 J; ideal CV at 0.5 ms, input 4102 J, output
+/// 3773, ΔE 17.1 (the smallest: tolerance 1.7 J), friction 92, damping 20,
+/// joints 202, error −0.88 J. The former 1 % of the input (45 J) passed
+/// with the damping or the energy change left out.
 #[test]
 fn the_drive_work_balances_friction_damping_and_the_energy_change() {
     for overrides in [
@@ -95,25 +105,39 @@ fn the_drive_work_balances_friction_damping_and_the_energy_change() {
         let mut all: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
         all.push("record.tables=[\"energy\"]".into());
         let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &all).unwrap();
+        let ideal_cv = overrides.iter().any(|o| o.contains("ideal-cv"));
         let mut sim = doc.simulation();
         while !sim.is_done() {
             sim.step().expect("stable");
         }
         let rec = sim.finish();
         let input = last(&rec, "drive_work");
-        let output = -last(&rec, "load_work");
         let total = column(&rec, "energy", "total");
-        let change = total.last().unwrap() - total[0];
-        let taken =
-            last(&rec, "friction_work") + last(&rec, "damping_work") + last(&rec, "joint_work");
-        let error = input - output - change - taken;
+        let terms = [
+            ("output", -last(&rec, "load_work")),
+            ("energy change", total.last().unwrap() - total[0]),
+            ("friction", last(&rec, "friction_work")),
+            ("damping", last(&rec, "damping_work")),
+            ("joint", last(&rec, "joint_work")),
+        ];
+        let error = input - terms.iter().map(|t| t.1).sum::<f64>();
         assert!(input > 1000.0, "{overrides:?}: drive work {input} J");
+        if !ideal_cv {
+            // Ball-key hinges have no penalty joints.
+            assert_eq!(terms[4].1, 0.0, "{overrides:?}: joint work");
+        }
+        let smallest = terms
+            .iter()
+            .filter(|t| t.1 != 0.0)
+            .map(|t| t.1.abs())
+            .fold(f64::INFINITY, f64::min);
+        let tolerance = 0.1 * smallest;
         assert!(
-            error.abs() < 0.01 * input,
-            "{overrides:?}: input {input} J, output {output} J, ΔE {change} J, dissipated {taken} J"
+            error.abs() < tolerance,
+            "{overrides:?}: input {input} J, terms {terms:?}: error {error} J > {tolerance} J"
         );
-        // Friction is a part of the balance that matters: leaving it out misses by more than 1 %.
-        assert!(last(&rec, "friction_work") > 0.02 * input, "{overrides:?}");
+        // Every term the model has is one the check would miss.
+        assert!(smallest > 1e-3 * input, "{overrides:?}: {terms:?}");
         assert!((last(&rec, "balance_error") - error).abs() < 1e-6 * input);
     }
 }

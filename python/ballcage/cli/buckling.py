@@ -24,9 +24,12 @@ def add(commands: Commands) -> None:
     for option, unit, what in (
         ("--friction-moment", "N·m", "static friction moment each hinge opposes to bending"),
         ("--bending-stiffness", "N·m/rad", "bending stiffness of each hinge"),
-        ("--axial-tension", "N", "axial tension along the chain (compression negative)"),
+        ("--hinge-play", "m", "axial play of each hinge, the length a fixed lower end leaves the chain to coil into"),
     ):
         parser.add_argument(option, type=float, default=0.0, metavar=unit, help=f"{what} [{unit}] (default 0)")
+    parser.add_argument("--axial-tension", type=float, default=None, metavar="N",
+                        help="axial tension along the chain [N] (compression negative; default: the scene's "
+                        "load.axial_force with pipe.lower_end = \"axially-free\", else 0)")
     parser.add_argument("--simulate", action="store_true", help="also run the three-torque check (seconds to minutes)")
     parser.set_defaults(command=command)
 
@@ -41,6 +44,7 @@ def command(args: argparse.Namespace) -> int:
             friction_moment=args.friction_moment,
             bending_stiffness=args.bending_stiffness,
             axial_tension=args.axial_tension,
+            hinge_play=args.hinge_play,
         )
     except ValueError as e:
         raise UsageError(str(e)) from e

@@ -70,7 +70,23 @@ def command(args: argparse.Namespace) -> int:
     if not args.quiet:
         for name, path in paths.items():
             print(_summary(name, path))
+        note = _fallback_note(paths)
+        if note is not None:
+            print(f"ballcage: warning: {note}")
     return 0
+
+
+def _fallback_note(paths: dict[str, Path]) -> str | None:
+    """The main run's fallback sentence (`Run.fallback_note`), from the metadata of one of its tables."""
+    import pyarrow.parquet as pq
+
+    from ballcage.run import Run
+
+    table = next((p for n, p in paths.items() if n in ("links", "drive", "bodies") and p.suffix == ".parquet"), None)
+    if table is None:
+        return None
+    schema = pq.read_schema(table)
+    return Run({table.stem: schema.empty_table()}, "").fallback_note
 
 
 def _summary(name: str, path: Path) -> str:

@@ -100,6 +100,8 @@ def command(args: argparse.Namespace) -> int:
             for line in (margin_line(result.tables["wear"]), wear_line(result.tables["wear"])):
                 if line is not None:
                     print(f"ballcage: {line}")
+        if result.fallback_note is not None:
+            print(f"ballcage: warning: {result.fallback_note}")
     return 0
 
 

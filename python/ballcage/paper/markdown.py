@@ -65,6 +65,10 @@ def comparison_markdown(
             note = note.replace(phases["note"], "phases: listed under the table")
         note = note.replace("|", "\\|")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
+    if run is not None and run.fallback_note is not None:
+        lines[lines.index("| key | paper | ours | unit | ratio | note |")] = (
+            f"**Warning: {run.fallback_note}.**\n\n| key | paper | ours | unit | ratio | note |"
+        )
     lines += _phase_lines(phases)
     if run is not None:
         lines += place_lines(run)

@@ -62,7 +62,7 @@ pub enum HingeModel {
     IdealCv,
 }
 
-/// How the lower connector is held (docs/model.md §4, "Connectors").
+/// How the lower connector is held (docs/paper.md, "The chain's end restraint").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum LowerEnd {
@@ -248,7 +248,12 @@ pub struct PipeSpec {
     /// Sample points along each link (rims included) that bracket the
     /// extrema of its depth in the tube (or, with `"patches"`, locate its
     /// contact patches); the force does not depend on this count once each
-    /// extremum has a bracket of its own. PROPOSAL: 5.
+    /// extremum has a bracket of its own. PROPOSAL: 33 (6.25 mm apart):
+    /// the compared quantities agree within 0.1 % from 5 samples up, but a
+    /// maximum–minimum pair hidden between two samples joins the law with a
+    /// finite step when it reaches a sample, and those steps cost the
+    /// implicit integrator step halvings (over the paper's first 1.2 s:
+    /// 2612 at 5 samples, 935 at 17, 204 at 33; docs/paper.md).
     pub tube_contact_points: u32,
     /// How a link's line contact with the tube becomes point laws:
     /// `"level-sets"` (the IMPACT law at every depth maximum minus the law
@@ -353,7 +358,7 @@ impl Default for PipeSpec {
             connector_diameter: 0.122,
             connector_mass: 17.243,
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
-            tube_contact_points: 5,
+            tube_contact_points: 33,
             tube_contact_law: LineLawSpec::LevelSets,
             neck_radius: 0.019,
             link_edge_radius: 0.002,

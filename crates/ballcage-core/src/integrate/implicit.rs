@@ -211,6 +211,9 @@ pub struct Stats {
     /// Part steps of h/16 that SDIRK2's Newton could not solve and that
     /// were taken by the linearly implicit Euler step instead.
     pub fallbacks: u64,
+    /// The most halvings any step needed (SDIRK2): the smallest part step
+    /// taken is h/2^this.
+    pub deepest_halving: u32,
 }
 
 /// γ of SDIRK2.
@@ -365,6 +368,7 @@ impl Implicit {
         h: f64,
         depth: u32,
     ) -> Result<(), String> {
+        self.stats.deepest_halving = self.stats.deepest_halving.max(depth);
         match self.sdirk2_single(model, dynamics, state, h) {
             Err(_) if depth < MAX_HALVINGS => {
                 self.stats.halvings += 1;
