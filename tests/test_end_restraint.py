@@ -4,9 +4,10 @@
    from Python (`ballcage.simulate(..., overrides=[...])`), with their unit in
    `scene show` and errors that name the field, the value and the reason.
 2. The buckling criterion's axial-force and play terms against hand calculations.
-3. The axial-force term against simulation: a straight chain of 12 ideal-CV links
-   pulled with 5 kN stays straight at 0.8 × the predicted torque and coils onto the
-   wall at 1.25 × (a threshold wrong by 2× fails one side). About 5 s on 2 cores.
+3. The axial-force term against simulation: a straight chain of 6 ideal-CV links
+   pulled with 5 kN stays straight at 0.9 × the predicted torque and coils onto the
+   wall at 1.1 × (a threshold wrong by 2×, or eq. 3.7's long-chain value, fails one
+   side). About 5 s on 2 cores.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import sys
 import pytest
 
 import ballcage
-from ballcage.buckling import buckling, play_excursion, simulate_check
+from ballcage.buckling import buckling, finite_greenhill, play_excursion, simulate_check
 
 FREE = ['pipe.lower_end="axially-free"']
 
@@ -79,17 +80,27 @@ def test_the_axial_force_and_the_play_enter_the_criterion_as_calculated_by_hand(
         buckling(hinge_play=-1e-3)
 
 
-def test_the_tension_threshold_brackets_the_simulated_one_within_25_percent():
+def test_the_finite_chain_threshold_matches_its_closed_forms():
+    # eq. 3.9: 3 links under tension alone: √3·N·l; 4 links: √(8/5)·N·l; the long-chain limit is
+    # eq. 3.7's N·l; stiffness alone on 3 links: √20·k_b (hand solution of the 4 × 4 system).
+    assert finite_greenhill(3, 0.2, 1000.0, 0.0) == pytest.approx(math.sqrt(3) * 200.0, rel=1e-9)
+    assert finite_greenhill(4, 0.2, 1000.0, 0.0) == pytest.approx(math.sqrt(8 / 5) * 200.0, rel=1e-9)
+    assert finite_greenhill(200, 0.2, 1000.0, 0.0) == pytest.approx(200.0, rel=1e-3)
+    assert finite_greenhill(3, 0.2, 0.0, 1.0) == pytest.approx(math.sqrt(20), rel=1e-9)
+    assert finite_greenhill(12, 0.2, -1000.0, 0.0) == 0.0
+
+
+def test_the_tension_threshold_brackets_the_simulated_one_within_10_percent():
     # A nearly straight tube (R = 1 km: the end hinges' swing circles are 20 µm), no gravity,
-    # 12 ideal-CV links, the lower end free and pulled with 5 kN: only the global mode can take
-    # the chain to the wall. Predicted N·l = 1000 N·m (the finite chain with clamped connectors:
-    # 1.030·N·l, docs/buckling.md §3a); measured between 1.0 and 1.1 N·l.
+    # 6 ideal-CV links, the lower end free and pulled with 5 kN: only the global mode can take the
+    # chain to the wall. Predicted (eq. 3.9) 1.1154·N·l = 1115 N·m; measured between 1100 and
+    # 1150 N·m (docs/buckling.md §3a). Eq. 3.7's N·l = 1000 N·m would fail the upper bracket.
     scene = [
-        'pipe.hinge="ideal-cv"', "pipe.joints=12", "borehole.curvature_radius=1000", "world.gravity=0",
+        'pipe.hinge="ideal-cv"', "pipe.joints=6", "borehole.curvature_radius=1000", "world.gravity=0",
         *FREE, "load.axial_force=5000",
     ]
-    predicted = buckling(overrides=scene).greenhill
-    assert predicted == pytest.approx(1000.0, rel=1e-9)
-    below, above = simulate_check(None, [0.8 * predicted, 1.25 * predicted], overrides=scene)
+    predicted = buckling(overrides=scene).finite_greenhill
+    assert predicted == pytest.approx(1115.38, rel=1e-5)
+    below, above = simulate_check(None, [0.9 * predicted, 1.1 * predicted], overrides=scene)
     assert below.wall_force == 0.0 and below.lateral_offset < 1e-3, below
-    assert above.wall_force > 100.0 and above.lateral_offset > 5e-3, above
+    assert above.wall_force > 20.0 and above.lateral_offset > 5e-3, above

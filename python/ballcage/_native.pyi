@@ -123,7 +123,7 @@ class Scene:
 
     @property
     def integrated_bodies(self) -> list[str]:
-        """Names of the bodies the integrator moves (motion ``dynamic`` or ``spin``), in body order; a drill pipe's expanded ones."""
+        """Names of the bodies the integrator moves (motion ``dynamic``, ``spin`` or ``spin-slide``), in body order; a drill pipe's expanded ones."""
 
     def unit(self, key: str) -> str:
         """The unit of the field at a dotted key, as ``to_toml(units=True)`` prints it.

@@ -40,6 +40,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from ballcage._native import InputError
 from ballcage.scene import SceneSource, default_scene, load_scene
 
@@ -49,6 +51,7 @@ __all__ = [
     "SimulatedTorque",
     "buckling",
     "end_wall_force",
+    "finite_greenhill",
     "play_excursion",
     "simulate_check",
 ]
@@ -95,11 +98,16 @@ class Buckling:
     #: takes up the hinges' play: the quarter-turn helix through the end hinges whose excess length is
     #: (n + 1)·play (eq. 3.8). ``inf`` with an axially free lower end, which lets it coil freely.
     play_excursion: float = math.inf
+    #: The global mode's threshold torque [N·m] of the finite chain between its clamped connectors
+    #: (eq. 3.9; ``inf`` when neither tension nor stiffness is given); eq. 3.7 (`greenhill`) is its
+    #: long-chain limit: 1.030× it for 12 links, 1.115× for 6 under tension alone.
+    finite_greenhill: float = math.inf
 
     def __str__(self) -> str:
         rows = [f"threshold torque          {self.threshold:12.4g} N·m  ({self.mode})"]
         rows += [f"{k:<26}{v:12.4g}" for k, v in self.terms.items()]
         rows.append(f"Greenhill torque          {self.greenhill:12.4g} N·m")
+        rows.append(f"finite-chain Greenhill    {self.finite_greenhill:12.4g} N·m")
         rows.append(f"play excursion            {self.play_excursion:12.4g} m")
         rows.append("hinge  bend [deg]  D_k [1]     W_k/T [1/m]  swing radius [mm]  g across [m/s²]  T_c [N·m]")
         pitch = self.terms["pitch [m]"]
@@ -183,7 +191,38 @@ def buckling(
         "lower end axially free": float(free_end),
     }
     excursion = math.inf if free_end else play_excursion(n, pitch, hinge_play)
-    return Buckling(threshold, mode, hinges, greenhill, bends, terms, excursion)
+    finite = finite_greenhill(n, pitch, axial_tension, bending_stiffness)
+    return Buckling(threshold, mode, hinges, greenhill, bends, terms, excursion, finite)
+
+
+def finite_greenhill(links: int, pitch: float, tension: float, stiffness: float) -> float:
+    """Smallest torque [N·m] at which a straight chain of `links` CV links leaves its axis (eq. 3.9).
+
+    The linearised link equations of docs/buckling.md §3, i·l·(V + N·s_i) = (T/2)·(s_{i−1} − s_{i+1})
+    + i·k_b·(s_{i+1} − 2s_i + s_{i−1}), for the slopes s_1 … s_n of `links` links of `pitch` l [m],
+    with the connectors' axes held (s_0 = s_{n+1} = 0) and both end hinges on the axis (Σ s_i = 0),
+    under axial `tension` N [N] and hinge bending `stiffness` k_b [N·m/rad]: the smallest T > 0 at
+    which they have a solution. ``inf`` when neither term is given (as `Buckling.greenhill`) or no
+    torque buckles the chain, 0 when nothing holds it (compression without stiffness).
+    """
+    n = links
+    if tension == 0.0 and stiffness == 0.0:
+        return math.inf
+    if tension < 0.0 and stiffness == 0.0:
+        return 0.0
+    # A(T) = A0 + T·A1 singular ⟺ μ = −1/T an eigenvalue of A0⁻¹·A1.
+    c = pitch * tension * np.eye(n) + stiffness * (2.0 * np.eye(n) - np.eye(n, k=1) - np.eye(n, k=-1))
+    a0 = np.zeros((n + 1, n + 1), dtype=complex)
+    a0[:n, :n], a0[:n, n], a0[n, :n] = 1j * c, 1j * pitch, 1.0
+    a1 = np.zeros((n + 1, n + 1), dtype=complex)
+    a1[:n, :n] = 0.5 * (np.eye(n, k=1) - np.eye(n, k=-1))
+    try:
+        mu = np.linalg.eigvals(np.linalg.solve(a0, a1))
+    except np.linalg.LinAlgError:
+        return 0.0  # C singular: a mode that nothing holds
+    torques = [-1.0 / m for m in mu if abs(m) > 1e-12]
+    real = [t.real for t in torques if abs(t.imag) <= 1e-9 * abs(t) and t.real > 0.0]
+    return min(real, default=math.inf)
 
 
 def play_excursion(links: int, pitch: float, play: float) -> float:

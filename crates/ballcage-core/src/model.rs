@@ -265,6 +265,9 @@ pub struct Model {
     pub threads: usize,
     /// Newton iterations of the `sdirk2` integrator.
     pub newton: crate::scene::NewtonSpec,
+    /// Tolerances (rtol [–], atol [m, rad, m/s, rad/s]) of adaptive steps;
+    /// `None`: fixed steps of `dt` ([`crate::scene::SimulationSpec::rtol`]).
+    pub tolerance: Option<(f64, f64)>,
     /// Largest energy the integrator may create, as a fraction of the
     /// energy scale ([`crate::scene::DivergenceSpec::energy_growth`]).
     pub energy_growth: f64,

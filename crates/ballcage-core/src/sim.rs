@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 use crate::assembly::assemble;
 use crate::dynamics::{ContactEval, ContactWatch, Dynamics, Energy};
 use crate::error::{SceneError, SimulationError};
-use crate::integrate::{self, Stats, Workspace};
+use crate::integrate::{self, ErrorStats, Stats, Workspace};
 use crate::math::Vec3;
 use crate::model::{Model, Motion, State};
 use crate::record::{Observer, Recorder, Recording};
@@ -155,6 +155,13 @@ impl Simulation {
         self.workspace.stats()
     }
 
+    /// What the error-estimating integrator (`esdirk32`) did: accepted and
+    /// rejected steps, the smallest step, the accumulated error estimate;
+    /// `None` for the other integrators.
+    pub fn error_stats(&self) -> Option<ErrorStats> {
+        self.workspace.error_stats()
+    }
+
     /// The divergence that stopped the run, if any.
     pub fn failure(&self) -> Option<&SimulationError> {
         self.failed.as_ref()
@@ -276,6 +283,7 @@ impl Simulation {
     pub fn finish(self) -> Recording {
         let complete = self.is_done() && self.failed.is_none();
         let stats = self.workspace.stats();
+        let (smallest, error_metadata) = (self.smallest_step(), self.error_metadata());
         let mut metadata = vec![
             ("ballcage.scene".to_string(), self.scene_toml),
             ("ballcage.version".to_string(), crate::VERSION.to_string()),
@@ -311,10 +319,7 @@ impl Simulation {
             ),
             (
                 "ballcage.smallest_step_s".to_string(),
-                format!(
-                    "{:e}",
-                    self.model.dt / f64::from(1u32 << stats.deepest_halving)
-                ),
+                format!("{smallest:e}"),
             ),
             (
                 "ballcage.wall_time_s".to_string(),
@@ -326,6 +331,7 @@ impl Simulation {
             ),
             ("ballcage.complete".to_string(), complete.to_string()),
         ];
+        metadata.extend(error_metadata);
         if let Some(e) = &self.failed {
             metadata.push(("ballcage.error".to_string(), e.to_string()));
         }
@@ -338,6 +344,46 @@ impl Simulation {
             part_labels,
             metadata,
         }
+    }
+
+    /// The smallest step or part step taken [s]: `simulation.dt` halved as
+    /// often as any step was, or the smallest adaptive step.
+    pub fn smallest_step(&self) -> f64 {
+        let halved = self.model.dt / f64::from(1u32 << self.workspace.stats().deepest_halving);
+        self.workspace
+            .error_stats()
+            .map_or(halved, |e| halved.min(e.smallest_step))
+    }
+
+    /// The metadata of an integrator with an error estimate (`esdirk32`):
+    /// accepted and rejected steps, the accumulated estimate of the global
+    /// error (the sums of each step's largest local error on a position
+    /// [m] and on a velocity [m/s]) and the tolerances; empty otherwise.
+    fn error_metadata(&self) -> Vec<(String, String)> {
+        let Some(e) = self.workspace.error_stats() else {
+            return vec![];
+        };
+        let mut out = vec![
+            ("ballcage.accepted_steps", e.accepted.to_string()),
+            ("ballcage.rejected_steps", e.rejected.to_string()),
+            (
+                "ballcage.error_estimate",
+                format!("{:e} m, {:e} m/s", e.position_error, e.velocity_error),
+            ),
+            (
+                "ballcage.error_estimate_position_m",
+                format!("{:e}", e.position_error),
+            ),
+            (
+                "ballcage.error_estimate_velocity_m_s",
+                format!("{:e}", e.velocity_error),
+            ),
+        ];
+        if let Some((rtol, atol)) = self.model.tolerance {
+            out.push(("ballcage.rtol", format!("{rtol:e}")));
+            out.push(("ballcage.atol", format!("{atol:e}")));
+        }
+        out.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
     }
 
     /// Records the failure and returns it, with the stable-step advice.
@@ -424,7 +470,7 @@ impl Simulation {
             }
             // No stability limit on the linearized contacts: resolve the
             // stiffest contact's period instead.
-            IntegratorKind::Sdirk2 => {
+            IntegratorKind::Sdirk2 | IntegratorKind::Esdirk32 => {
                 let (period, pair) = w.period();
                 (
                     period / 10.0,

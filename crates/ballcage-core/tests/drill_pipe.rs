@@ -363,11 +363,12 @@ fn with_the_paper_law_a_close_groove_opens_its_contact_angle_and_keys_carry_less
 /// moves outward, and the contact line stays at 44.9° from the head race's
 /// radial direction, while the seat race's own groove section has turned
 /// with the seat by φ, half the two hinges' turn, so its angle reads φ more
-/// (48.1° by hand). Checked: head race within 0.6° of 45°, seat race within
-/// 0.6° of the head race's angle + φ; 0.6° covers the 4 mm groove offset
-/// the section leaves out (measured +0.2° and +0.5° with SDIRK2), and is
-/// 5× below the seat race's 3.2° opening. The close arch (ρ_g = 7.8 mm)
-/// opens to 76° under the same load (section model).
+/// (48.1° by hand). Checked: head race within 0.3° of 45°, seat race within
+/// 0.3° of the head race's angle + φ; 0.3° covers the 4 mm groove offset
+/// the c → 0 section leaves out (measured: head 45.04°, seat 0.13° above
+/// the head's + φ, φ = 3.53°), and is 10× below the seat race's opening.
+/// The close arch (ρ_g = 7.8 mm) opens to 76° under the same load (section
+/// model).
 #[test]
 fn with_the_default_groove_the_contact_angle_holds_at_the_papers_peak_key_load() {
     let torque = 33_500.0 * 6.0 * 0.0315 * std::f64::consts::FRAC_PI_4.sin();
@@ -388,15 +389,15 @@ fn with_the_default_groove_the_contact_angle_holds_at_the_papers_peak_key_load()
         opened(a)
     );
     assert!(opened(0.0078 - 0.0075 - 1e-5) > 70.0);
-    let phi = (0.5 * turned).to_degrees();
-    assert!(phi > 5.0 * 0.6, "turn per hinge {phi}°");
+    let (phi, tol) = ((0.5 * turned).to_degrees(), 0.3);
+    assert!(phi > 10.0 * tol, "turn per hinge {phi}°");
     for (i, (inner, outer)) in angles.iter().enumerate() {
         assert!(
-            (inner - 45.0).abs() < 0.6,
+            (inner - 45.0).abs() < tol,
             "key {i}: head-race contact angle {inner}°"
         );
         assert!(
-            (outer - (inner + phi)).abs() < 0.6,
+            (outer - (inner + phi)).abs() < tol,
             "key {i}: seat-race contact angle {outer}° vs {inner}° + {phi}°"
         );
     }

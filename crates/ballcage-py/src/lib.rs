@@ -289,8 +289,8 @@ impl Scene {
         self.inner.kind().name()
     }
 
-    /// Names of the bodies the integrator moves (motion `dynamic` or
-    /// `spin`: `BodySpec::is_integrated`), in body order; for a drill pipe,
+    /// Names of the bodies the integrator moves (motion `dynamic`, `spin`
+    /// or `spin-slide`: `BodySpec::is_integrated`), in body order; for a drill pipe,
     /// those of its expansion.
     #[getter]
     fn integrated_bodies(&self) -> Vec<String> {

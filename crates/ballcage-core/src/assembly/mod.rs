@@ -57,6 +57,10 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         integrator: scene.simulation.integrator,
         dt: scene.simulation.dt,
         newton: scene.simulation.newton.clone(),
+        tolerance: scene
+            .simulation
+            .rtol
+            .map(|rtol| (rtol, scene.simulation.atol.unwrap_or(rtol))),
         threads: match scene.simulation.threads {
             0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
             n => n as usize,

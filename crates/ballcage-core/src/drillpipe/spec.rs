@@ -816,6 +816,8 @@ impl Default for DrillPipeSpec {
                 divergence: DivergenceSpec::default(),
                 threads: 1,
                 max_steps: crate::scene::default_max_steps(),
+                rtol: None,
+                atol: None,
             },
             world: GravitySpec::default(),
             borehole: BoreholeSpec::default(),

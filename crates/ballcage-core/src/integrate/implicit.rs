@@ -1,4 +1,5 @@
-//! The implicit integrators: linearly implicit Euler and SDIRK2, both on the
+//! The implicit integrators: linearly implicit Euler, SDIRK2 and (in
+//! [`esdirk`], on SDIRK2's Newton iterations) ESDIRK3(2), all on the
 //! rotation manifold, sharing one sparse matrix pattern and factorization.
 //!
 //! # Linearly implicit Euler
@@ -71,6 +72,51 @@ use crate::scene::LinearSolver;
 
 use super::blocklu::BlockLu;
 use super::sparselu::SparseLu;
+
+#[path = "esdirk.rs"]
+mod esdirk;
+
+pub use esdirk::ErrorStats;
+
+/// Which diagonally implicit scheme the Newton iterations solve the stages
+/// of: they share the iterations, the Newton matrix and the linear solver,
+/// and differ in γ and in what each stage already knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scheme {
+    /// Alexander's SDIRK2 (this module).
+    Sdirk2,
+    /// Kennedy–Carpenter ESDIRK3(2)4L[2]SA ([`esdirk`]).
+    Esdirk32,
+}
+
+impl Scheme {
+    /// γ, the diagonal of the Butcher matrix.
+    fn gamma(self) -> f64 {
+        match self {
+            Self::Sdirk2 => GAMMA,
+            Self::Esdirk32 => esdirk::GAMMA,
+        }
+    }
+
+    /// The tolerance of the stages' Newton iterations:
+    /// `simulation.newton.tolerance`, and with adaptive steps at most a
+    /// tenth of `simulation.rtol` (the iterations' error well below the
+    /// step's).
+    fn newton_tolerance(self, model: &Model) -> f64 {
+        match (self, model.tolerance) {
+            (Self::Esdirk32, Some((rtol, _))) => model.newton.tolerance.min(0.1 * rtol),
+            _ => model.newton.tolerance,
+        }
+    }
+
+    /// The name in error messages.
+    fn name(self) -> &'static str {
+        match self {
+            Self::Sdirk2 => "SDIRK2",
+            Self::Esdirk32 => "ESDIRK3(2)",
+        }
+    }
+}
 
 /// How a body's unknowns map to its world twist [v; ω].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -187,6 +233,13 @@ pub(crate) struct Implicit {
     v: Vec<f64>,
     base: Vec<f64>,
     a1: Vec<f64>,
+    /// The velocity increment a stage already knows from the earlier
+    /// stages, h·Σ_{j<i} a_ij·A_j (SDIRK2: h(1 − γ)·A_1 at stage 2).
+    known_dv: Vec<f64>,
+    /// The scheme whose stages `newton` solves.
+    scheme: Scheme,
+    /// ESDIRK3(2)'s stage data and step control, made at its first step.
+    esdirk: Option<Box<esdirk::Stages>>,
     /// The last Newton increment, and the mass scale of each unknown
     /// (m, the largest principal inertia, or the spin inertia).
     step: Vec<f64>,
@@ -292,6 +345,9 @@ impl Implicit {
             v: vec![0.0; n],
             base: vec![0.0; n],
             a1: vec![0.0; n],
+            known_dv: vec![0.0; n],
+            scheme: Scheme::Sdirk2,
+            esdirk: None,
             step: vec![0.0; n],
             mass_scale,
             stage: None,
@@ -369,7 +425,11 @@ impl Implicit {
         depth: u32,
     ) -> Result<(), String> {
         self.stats.deepest_halving = self.stats.deepest_halving.max(depth);
-        match self.sdirk2_single(model, dynamics, state, h) {
+        let single = match self.scheme {
+            Scheme::Sdirk2 => self.sdirk2_single(model, dynamics, state, h),
+            Scheme::Esdirk32 => self.esdirk_single(model, dynamics, state, h),
+        };
+        match single {
             Err(_) if depth < MAX_HALVINGS => {
                 self.stats.halvings += 1;
                 self.sdirk2_split(model, dynamics, state, h / 2.0, depth + 1)?;
@@ -457,7 +517,7 @@ impl Implicit {
         t_stage: f64,
         h: f64,
     ) -> Result<u32, String> {
-        let gh = GAMMA * h;
+        let gh = self.scheme.gamma() * h;
         let settings = &model.newton;
         let mut previous = f64::INFINITY;
         let mut last_residual = f64::INFINITY;
@@ -489,7 +549,7 @@ impl Implicit {
             // The contraction rate, unknown at the first iteration of a Jacobian.
             let theta = (previous.is_finite()).then(|| norm / previous);
             previous = norm;
-            if converged(norm, theta, settings.tolerance) {
+            if converged(norm, theta, self.scheme.newton_tolerance(model)) {
                 self.set_stage(model, start, stage, s, t_stage, h);
                 return Ok(k);
             }
@@ -499,9 +559,10 @@ impl Implicit {
             }
         }
         Err(format!(
-            "Newton iterations of SDIRK2 stage {} did not converge within \
+            "Newton iterations of {} stage {} did not converge within \
              simulation.newton.max_iterations = {} (last increment {previous:.3e} relative, \
              simulation.newton.tolerance = {:e})",
+            self.scheme.name(),
             s + 1,
             settings.max_iterations,
             settings.tolerance
@@ -522,7 +583,8 @@ impl Implicit {
         self.assemble_matrix(model, stage, gh);
         if !self.factor() {
             return Err(format!(
-                "the Newton matrix of SDIRK2 stage {} is singular",
+                "the Newton matrix of {} stage {} is singular",
+                self.scheme.name(),
                 s + 1
             ));
         }
@@ -546,7 +608,8 @@ impl Implicit {
     fn increment(&mut self, s: usize) -> Result<f64, String> {
         if !self.solve() {
             return Err(format!(
-                "the Newton increment of SDIRK2 stage {} is not finite",
+                "the Newton increment of {} stage {} is not finite",
+                self.scheme.name(),
                 s + 1
             ));
         }
@@ -589,8 +652,9 @@ impl Implicit {
         }
     }
 
-    /// Sets `stage` to stage `s` with iterate `self.v`: displacement weights
-    /// γ·V (stage 1) or (1 − γ)·V_1 + γ·V (stage 2, V_1 = v_n + γh·A_1).
+    /// Sets `stage` to stage `s` with iterate `self.v`: SDIRK2's
+    /// displacement weights γ·V (stage 1) or (1 − γ)·V_1 + γ·V (stage 2,
+    /// V_1 = v_n + γh·A_1), or ESDIRK3(2)'s ([`Self::esdirk_base`]).
     fn set_stage(
         &mut self,
         model: &Model,
@@ -600,13 +664,31 @@ impl Implicit {
         t_stage: f64,
         h: f64,
     ) {
-        for k in 0..self.n {
-            self.base[k] = GAMMA * self.v[k];
-            if s == 1 {
-                let v1 = self.v_n[k] + GAMMA * h * self.a1[k];
-                self.base[k] += (1.0 - GAMMA) * v1;
+        match self.scheme {
+            Scheme::Sdirk2 => {
+                for k in 0..self.n {
+                    self.base[k] = GAMMA * self.v[k];
+                    if s == 1 {
+                        let v1 = self.v_n[k] + GAMMA * h * self.a1[k];
+                        self.base[k] += (1.0 - GAMMA) * v1;
+                    }
+                }
             }
+            Scheme::Esdirk32 => self.esdirk_base(model, h),
         }
+        self.place_stage(model, start, stage, t_stage, h);
+    }
+
+    /// Sets `stage` at `t_stage` to the velocities `self.v` and the poses
+    /// x_n + h·base, Exp(h·base)·R_n.
+    fn place_stage(
+        &mut self,
+        model: &Model,
+        start: &State,
+        stage: &mut State,
+        t_stage: f64,
+        h: f64,
+    ) {
         stage.t = t_stage;
         for &i in &model.integrated {
             let (off, basis) = self.dofs[i].expect("integrated");
@@ -641,13 +723,19 @@ impl Implicit {
     }
 
     /// −r(V) into `rhs` from the wrenches last evaluated at `stage`:
-    /// r = M·(V − v_n − h(1 − γ)·A_1·[s = 1]) − γh·(f − ω×I_wω).
+    /// r = M·(V − v_n − known_dv) − γh·(f − ω×I_wω), SDIRK2's known_dv
+    /// h(1 − γ)·A_1·[s = 1] (ESDIRK3(2) sets its own before each stage).
     fn residual(&mut self, model: &Model, dynamics: &Dynamics, stage: &State, s: usize, h: f64) {
-        let gh = GAMMA * h;
-        let known = if s == 1 { (1.0 - GAMMA) * h } else { 0.0 };
+        if self.scheme == Scheme::Sdirk2 {
+            let known = if s == 1 { (1.0 - GAMMA) * h } else { 0.0 };
+            for k in 0..self.n {
+                self.known_dv[k] = known * self.a1[k];
+            }
+        }
+        let gh = self.scheme.gamma() * h;
         let (force, torque) = (dynamics.forces(), dynamics.torques());
-        let (v, v_n, a1) = (&self.v, &self.v_n, &self.a1);
-        let dv = |k: usize| v[k] - v_n[k] - known * a1[k];
+        let (v, v_n, known_dv) = (&self.v, &self.v_n, &self.known_dv);
+        let dv = |k: usize| v[k] - v_n[k] - known_dv[k];
         for &i in &model.integrated {
             let (off, basis) = self.dofs[i].expect("integrated");
             match (basis, model.bodies[i].motion) {

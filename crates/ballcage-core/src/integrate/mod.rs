@@ -5,15 +5,15 @@
 //! `R = R₀·Exp(ξ)` (Runge–Kutta–Munthe-Kaas), so quaternions never leave the
 //! unit sphere by more than round-off.
 //!
-//! [`IntegratorKind::LinearlyImplicitEuler`] and [`IntegratorKind::Sdirk2`]
-//! ([`implicit`]) also see the Jacobian of the forces, through
+//! [`IntegratorKind::LinearlyImplicitEuler`], [`IntegratorKind::Sdirk2`] and
+//! [`IntegratorKind::Esdirk32`] ([`implicit`], `esdirk.rs`) also see the Jacobian of the forces, through
 //! [`Dynamics::forces_and_jacobian`].
 
 mod blocklu;
 mod implicit;
 mod sparselu;
 
-pub use implicit::Stats;
+pub use implicit::{ErrorStats, Stats};
 
 use crate::dynamics::{Accel, Dynamics, Mode};
 use crate::math::{Vec3, dexp_inv, exp_map};
@@ -59,6 +59,12 @@ impl Workspace {
             .as_ref()
             .map_or_else(Stats::default, |w| w.stats)
     }
+
+    /// What ESDIRK3(2)'s steps and error estimate did so far (`None` for
+    /// the other integrators, or before its first step).
+    pub fn error_stats(&self) -> Option<ErrorStats> {
+        self.implicit.as_ref().and_then(|w| w.error_stats())
+    }
 }
 
 /// Takes step `n` of the run: advances `state` from t_n = n·dt to
@@ -90,6 +96,7 @@ pub fn step(
             implicit(ws, model).step(model, dynamics, state, h)
         }
         IntegratorKind::Sdirk2 => implicit(ws, model).sdirk2_step(model, dynamics, state, h)?,
+        IntegratorKind::Esdirk32 => implicit(ws, model).esdirk_step(model, dynamics, state, h)?,
     }
     state.t = (n + 1) as f64 * h;
     Ok(())

@@ -1,0 +1,394 @@
+//! The ESDIRK3(2)4L[2]SA integrator (`esdirk32`): observed order 3 on a
+//! linear and on nonlinear problems with known solutions, order 2 of its
+//! embedded error estimate, a stiff problem whose fast scale the steps do
+//! not resolve, and adaptive steps whose error follows the tolerance.
+
+mod common;
+
+use ballcage_core::Simulation;
+
+/// A 1 kg ball on a linear spring-dashpot contact (k = 1e4 N/m, c = 20
+/// N·s/m: ω₀ = 100 rad/s, ζ = 0.1) under gravity, starting at its rest depth
+/// moving up at 0.05 m/s: z(t) = z_s + (v₀/ω_d)·e^(−ζω₀t)·sin(ω_d·t),
+/// ω_d = ω₀·√(1 − ζ²) (as tests/sdirk2.rs). `extra`: more `[simulation]` keys.
+fn oscillator(dt: f64, extra: &str) -> Simulation {
+    common::sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.1
+        dt = {dt}
+        output_interval = 0.1
+        integrator = "esdirk32"
+        newton = {{ tolerance = 1e-13 }}
+        {extra}
+        [world]
+        gravity = [0.0, 0.0, -9.81]
+        [record]
+        tables = []
+        [[bodies]]
+        name = "floor"
+        motion = "fixed"
+        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
+        [[bodies]]
+        name = "ball"
+        shape = {{ type = "ball", radius = 0.05 }}
+        mass = 1.0
+        position = [0.0, 0.0, {z0}]
+        velocity = [0.0, 0.0, 0.05]
+        [[contacts]]
+        bodies = ["floor", "ball"]
+        normal = {{ law = "linear", stiffness = 1e4, damping = 20.0 }}
+        "#,
+        z0 = 0.05 - 9.81e-4,
+    ))
+}
+
+/// |z(T) − exact| [m] of a finished oscillator run.
+fn oscillator_error(sim: &Simulation) -> f64 {
+    let i = common::body(sim, "ball");
+    let t = sim.time();
+    let (w0, zeta) = (100.0, 0.1);
+    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
+    let exact = 0.05 - 9.81e-4 + 0.05 / wd * (-zeta * w0 * t).exp() * (wd * t).sin();
+    (sim.state().pos[i].z - exact).abs()
+}
+
+/// log2 of successive error ratios (the step halves each time).
+fn orders(errors: &[f64]) -> Vec<f64> {
+    errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect()
+}
+
+#[test]
+fn third_order_on_the_damped_oscillator() {
+    let errors: Vec<f64> = [4e-3, 2e-3, 1e-3]
+        .iter()
+        .map(|&dt| {
+            let mut sim = oscillator(dt, "");
+            sim.run().unwrap();
+            oscillator_error(&sim)
+        })
+        .collect();
+    let p = orders(&errors);
+    eprintln!("oscillator errors {errors:?}, orders {p:?}");
+    for p in &p {
+        assert!((p - 3.0).abs() < 0.2, "observed order {p:.3} ({errors:?})");
+    }
+}
+
+/// A tumbling asymmetric box without forces: the gyroscopic term alone
+/// turns the rotation axis (as tests/sdirk2.rs).
+fn tumbling(integrator: &str, dt: f64) -> Simulation {
+    common::sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.4
+        dt = {dt}
+        output_interval = 0.4
+        integrator = "{integrator}"
+        newton = {{ tolerance = 1e-14 }}
+        [record]
+        tables = []
+        [[bodies]]
+        name = "box"
+        shape = {{ type = "cuboid", half_extents = [0.1, 0.05, 0.02] }}
+        mass = 1.0
+        angular_velocity = [0.5, 4.0, 0.2]
+        "#
+    ))
+}
+
+#[test]
+fn third_order_on_the_rotation_manifold() {
+    // The free rotation against RK4 at 10 µs (error ~1e-16): the dexp
+    // correction of the stage rotations is what makes this third order.
+    let mut reference = tumbling("rk4", 1e-5);
+    reference.run().unwrap();
+    let i = common::body(&reference, "box");
+    let (r, w) = (reference.state().rot[i], reference.state().omega[i]);
+    let mut errors = vec![];
+    for dt in [2e-2, 1e-2, 5e-3] {
+        let mut sim = tumbling("esdirk32", dt);
+        sim.run().unwrap();
+        let (q, v) = (sim.state().rot[i], sim.state().omega[i]);
+        assert!((q.norm() - 1.0).abs() < 1e-12);
+        errors.push(q.angle_to(&r).max((v - w).norm() / w.norm()));
+    }
+    let p = orders(&errors);
+    eprintln!("tumbling errors {errors:?}, orders {p:?}");
+    for p in &p {
+        assert!((p - 3.0).abs() < 0.25, "observed order {p:.3} ({errors:?})");
+    }
+}
+
+/// A 14 g ball pressed into a half-space by gravity scaled to 100 N under a
+/// Hertz law (F = K·δ^1.5, no damping), released from its rest depth with
+/// 0.02 m/s downwards: it oscillates without leaving the floor, and its
+/// energy ½mv² + K·δ^2.5/2.5 − m·g·δ is conserved (docs/model.md §2.1).
+fn hertz(dt: f64) -> Simulation {
+    let (m, k, g) = (0.014f64, 1e9f64, 100.0 / 0.014);
+    let rest = (m * g / k).powf(1.0 / 1.5);
+    common::sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.01
+        dt = {dt}
+        output_interval = 0.01
+        integrator = "esdirk32"
+        newton = {{ tolerance = 1e-14 }}
+        [world]
+        gravity = [0.0, 0.0, {neg_g}]
+        [record]
+        tables = []
+        [[bodies]]
+        name = "floor"
+        motion = "fixed"
+        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
+        [[bodies]]
+        name = "ball"
+        shape = {{ type = "ball", radius = 0.0075 }}
+        mass = {m}
+        position = [0.0, 0.0, {z0}]
+        velocity = [0.0, 0.0, -0.02]
+        [[contacts]]
+        bodies = ["floor", "ball"]
+        normal = {{ law = "impact", stiffness = {k}, exponent = 1.5, damping = 0.0, depth_max = 1e-3 }}
+        "#,
+        neg_g = -g,
+        z0 = 0.0075 - rest,
+    ))
+}
+
+/// The relative energy error at the end of a Hertz run.
+fn hertz_energy_error(dt: f64) -> f64 {
+    let (m, k, g) = (0.014f64, 1e9f64, 100.0 / 0.014);
+    let energy = |z: f64, v: f64| {
+        let d = (0.0075 - z).max(0.0);
+        0.5 * m * v * v + k * d.powf(2.5) / 2.5 + m * g * (z - 0.0075)
+    };
+    let mut sim = hertz(dt);
+    let i = common::body(&sim, "ball");
+    let s0 = sim.state().clone();
+    let e0 = energy(s0.pos[i].z, s0.vel[i].z);
+    sim.run().unwrap();
+    let s = sim.state();
+    let z = s.pos[i].z;
+    assert!(z < 0.0075, "the ball left the floor");
+    // Relative to the energy m·g·δ_rest the contact stores at rest.
+    let rest = (m * g / k).powf(1.0 / 1.5);
+    ((energy(z, s.vel[i].z) - e0) / (m * g * rest)).abs()
+}
+
+#[test]
+fn third_order_on_a_hertz_contact() {
+    // ω ≈ √(1.5·K·δ^0.5/m) ≈ 2.2e4 rad/s at the rest depth: steps of 10 to
+    // 2.5 µs resolve it (hω 0.22 to 0.055).
+    let errors: Vec<f64> = [1e-5, 5e-6, 2.5e-6]
+        .iter()
+        .map(|&dt| hertz_energy_error(dt))
+        .collect();
+    let p = orders(&errors);
+    eprintln!("hertz energy errors {errors:?}, orders {p:?}");
+    for p in &p {
+        assert!((p - 3.0).abs() < 0.3, "observed order {p:.3} ({errors:?})");
+    }
+}
+
+#[test]
+fn the_embedded_estimate_is_second_order() {
+    // The sum of the local estimates over the run, N·O(h³) = O(h²), and at
+    // least the size of the true global error of the third-order solution.
+    let mut sums = vec![];
+    for dt in [4e-3, 2e-3, 1e-3] {
+        let mut sim = oscillator(dt, "");
+        sim.run().unwrap();
+        let e = sim.error_stats().expect("esdirk32 has an estimate");
+        assert_eq!(e.accepted, sim.steps());
+        assert_eq!(e.rejected, 0);
+        assert!(e.position_error > oscillator_error(&sim));
+        sums.push(e.position_error);
+    }
+    let p = orders(&sums);
+    eprintln!("estimate sums {sums:?}, orders {p:?}");
+    for p in &p {
+        assert!((p - 2.0).abs() < 0.2, "estimate order {p:.3} ({sums:?})");
+    }
+}
+
+#[test]
+fn adaptive_error_follows_the_tolerance() {
+    // dt = 0.01 s is only the largest step (ω₀·dt = 1); the controller
+    // picks the steps. Ten times tighter tolerances cut the error about
+    // tenfold (steps ∝ tol^(1/3), a third-order error ∝ tol).
+    let mut errors = vec![];
+    let mut steps = vec![];
+    for rtol in [1e-4, 1e-5, 1e-6] {
+        let mut sim = oscillator(0.01, &format!("rtol = {rtol}\natol = {}", rtol * 1e-2));
+        sim.run().unwrap();
+        assert!((sim.time() - 0.1).abs() < 1e-15, "landed at {}", sim.time());
+        let e = sim.error_stats().expect("esdirk32 has an estimate");
+        assert!(e.smallest_step <= 0.01 && e.smallest_step > 0.0);
+        assert!(e.accepted >= sim.steps());
+        errors.push(oscillator_error(&sim));
+        steps.push((e.accepted, e.rejected, e.smallest_step));
+    }
+    eprintln!("adaptive errors {errors:?}, (accepted, rejected, smallest) {steps:?}");
+    for w in errors.windows(2) {
+        let ratio = w[0] / w[1];
+        assert!(
+            (4.0..25.0).contains(&ratio),
+            "error ratio {ratio:.2} ({errors:?})"
+        );
+    }
+    // More steps at the tighter tolerance.
+    assert!(steps[2].0 > steps[0].0);
+}
+
+#[test]
+fn the_run_metadata_counts_the_steps_and_the_estimate() {
+    let mut sim = oscillator(0.01, "rtol = 1e-5");
+    sim.run().unwrap();
+    let e = sim.error_stats().expect("esdirk32 has an estimate");
+    let meta: std::collections::HashMap<String, String> =
+        sim.finish().metadata.into_iter().collect();
+    let number = |key: &str| -> f64 {
+        meta.get(key)
+            .unwrap_or_else(|| panic!("no {key}"))
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(number("ballcage.accepted_steps"), e.accepted as f64);
+    assert_eq!(number("ballcage.rejected_steps"), e.rejected as f64);
+    assert!(e.rejected > 0, "the first step (dt) is too long for 1e-5");
+    assert_eq!(number("ballcage.smallest_step_s"), e.smallest_step);
+    assert!(number("ballcage.error_estimate_position_m") > 0.0);
+    assert!(number("ballcage.error_estimate_velocity_m_s") > 0.0);
+    assert!(meta["ballcage.error_estimate"].ends_with("m/s"));
+    assert_eq!(number("ballcage.rtol"), 1e-5);
+    assert_eq!(number("ballcage.atol"), 1e-5, "atol defaults to rtol");
+}
+
+#[test]
+fn tolerances_need_the_integrator_with_an_estimate() {
+    let base = |integrator: &str, extra: &str| {
+        format!(
+            r#"
+            [simulation]
+            duration = 0.1
+            dt = 0.01
+            output_interval = 0.1
+            integrator = "{integrator}"
+            {extra}
+            [[bodies]]
+            name = "ball"
+            shape = {{ type = "ball", radius = 0.05 }}
+            mass = 1.0
+            "#
+        )
+    };
+    for (integrator, extra, field) in [
+        ("sdirk2", "rtol = 1e-5", "simulation.rtol"),
+        ("esdirk32", "atol = 1e-5", "simulation.atol"),
+        ("esdirk32", "rtol = -1.0", "simulation.rtol"),
+    ] {
+        let e = ballcage_core::Scene::from_toml_str(&base(integrator, extra), &[])
+            .expect_err(extra)
+            .to_string();
+        assert!(e.contains(field), "{integrator}, {extra}: {e}");
+    }
+    // Fixed steps by default: no adaptive metadata beyond the estimate.
+    let mut sim = common::sim(&base("esdirk32", ""));
+    sim.run().unwrap();
+    let e = sim.error_stats().unwrap();
+    assert_eq!((e.accepted, e.rejected), (10, 0));
+    let meta: Vec<String> = sim.finish().metadata.into_iter().map(|m| m.0).collect();
+    assert!(!meta.contains(&"ballcage.rtol".to_string()));
+    let mut sim = common::sim(&base("sdirk2", ""));
+    sim.run().unwrap();
+    assert!(sim.error_stats().is_none());
+}
+
+/// The Prothero–Robinson problem in the engine: a ball (I = 2/5·m·r² =
+/// 1e-3 kg·m²) free to spin about x, tied by a CV joint's twist damper
+/// (c = 1e3 N·m·s/rad; a twist spring of 1e-9 N·m/rad, whose torque on the
+/// ~1e-4 rad lag is 1e-13 of the damper's; the hinge-point spring acts at
+/// the centres, which do not move) to a drive whose rate follows the
+/// Adams STEP φ(t) = S·Δ²(3 − 2Δ), Δ = t/T (S = 100 rad/s, T = 0.1 s):
+/// I·ω' = −c·(ω − φ), i.e. y' = λ(y − φ), λ = −c/I = −1e6 1/s.
+fn prothero_robinson(integrator: &str, dt: f64) -> Simulation {
+    common::sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.05
+        dt = {dt}
+        output_interval = 0.05
+        integrator = "{integrator}"
+        newton = {{ tolerance = 1e-15 }}
+        [record]
+        tables = []
+        [[bodies]]
+        name = "drive"
+        motion = "kinematic-spin"
+        spin_axis = [1.0, 0.0, 0.0]
+        spin_speed = 100.0
+        spin_ramp = 0.1
+        shape = {{ type = "ball", radius = 0.05 }}
+        [[bodies]]
+        name = "rotor"
+        motion = "spin"
+        spin_axis = [1.0, 0.0, 0.0]
+        shape = {{ type = "ball", radius = 0.05 }}
+        mass = 1.0
+        [[joints]]
+        type = "cv"
+        bodies = ["drive", "rotor"]
+        anchors = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+        stiffness = 1.0
+        damping = 0.0
+        twist_stiffness = 1e-9
+        twist_damping = 1e3
+        "#
+    ))
+}
+
+#[test]
+fn prothero_robinson_in_the_engine_converges_without_resolving_the_stiff_scale() {
+    // For a cubic φ the non-transient solution is exactly
+    // y = φ + φ'/λ + φ''/λ² + φ'''/λ³ (the transient, ~1e-8 rad/s, dies
+    // within microseconds). hλ = −5e3 … −625: the fast scale is never
+    // resolved; stage order 2 and stiff accuracy give errors of order h²/|λ|.
+    let errors = prothero_robinson_errors("esdirk32");
+    let p = orders(&errors);
+    eprintln!("engine Prothero-Robinson errors {errors:?}, orders {p:?}");
+    assert!(errors[0] < 1e-5, "{errors:?}");
+    for p in &p {
+        assert!((p - 2.0).abs() < 0.3, "observed order {p:.3} ({errors:?})");
+    }
+    // SDIRK2, also stiffly accurate, has the same order h²/|λ| here, with
+    // a constant 4 times larger (measured).
+    let sdirk2 = prothero_robinson_errors("sdirk2");
+    eprintln!("SDIRK2: errors {sdirk2:?}, orders {:?}", orders(&sdirk2));
+    for (a, b) in sdirk2.iter().zip(&errors) {
+        assert!(*a > 2.0 * b, "SDIRK2 {sdirk2:?} vs ESDIRK3(2) {errors:?}");
+    }
+}
+
+/// |ω(0.05 s) − exact| [rad/s] of the Prothero–Robinson scene at steps of
+/// 5, 2.5, 1.25 and 0.625 ms.
+fn prothero_robinson_errors(integrator: &str) -> Vec<f64> {
+    let (s, t_ramp, lambda) = (100.0f64, 0.1f64, -1e6f64);
+    let mut errors = vec![];
+    for dt in [5e-3, 2.5e-3, 1.25e-3, 6.25e-4] {
+        let mut sim = prothero_robinson(integrator, dt);
+        sim.run().unwrap();
+        let i = common::body(&sim, "rotor");
+        let t = sim.time();
+        let d = t / t_ramp;
+        let phi = s * d * d * (3.0 - 2.0 * d);
+        let phi1 = s * 6.0 * d * (1.0 - d) / t_ramp;
+        let phi2 = s * 6.0 * (1.0 - 2.0 * d) / (t_ramp * t_ramp);
+        let phi3 = -12.0 * s / t_ramp.powi(3);
+        let exact = phi + phi1 / lambda + phi2 / lambda.powi(2) + phi3 / lambda.powi(3);
+        errors.push((sim.state().omega_world(i).x - exact).abs());
+    }
+    errors
+}
