@@ -356,3 +356,20 @@ fn a_start_with_an_overlap_whose_energy_overflows_names_the_pair() {
     );
     assert!(e.reason.contains("the overlap of contact pair `"), "{e}");
 }
+
+#[test]
+fn a_hardness_below_1_mpa_and_a_wear_coefficient_above_1_are_refused() {
+    // fuzz/regressions/tiny-hardness-nan-wear.toml: 3e-319 Pa made the wear NaN.
+    let text = ballcage_core::loader::default_document().to_toml();
+    let ok: Vec<String> = vec![
+        "materials.pipe_steel.hardness=1e6".into(),
+        "wear.tube_coefficient=1".into(),
+    ];
+    assert!(ballcage_core::loader::Document::from_toml_str(&text, &ok).is_ok());
+    let e = pipe_error_of(&["materials.pipe_steel.hardness=3.22986e-319"]);
+    assert_eq!(e.path, "materials.pipe_steel.hardness");
+    assert!(e.reason.contains("at least 1e6 Pa"), "{e}");
+    let e = pipe_error_of(&["wear.tube_coefficient=1.5"]);
+    assert_eq!(e.path, "wear.tube_coefficient");
+    assert!(e.reason.contains("must not exceed 1"), "{e}");
+}

@@ -564,12 +564,27 @@ impl SolidSpec {
             ));
         }
         positive(&format!("{path}.hardness"), self.hardness)?;
+        if self.hardness < MIN_HARDNESS {
+            // Found by fuzzing (fuzz/regressions/tiny-hardness-nan-wear.toml):
+            // 3e-319 Pa made the wear rate k/H infinite and the wear volume NaN.
+            return Err(SceneError::new(
+                format!("{path}.hardness"),
+                self.hardness,
+                format!(
+                    "must be at least {MIN_HARDNESS:e} Pa (1 MPa: any solid that carries a contact is far \
+                     harder, HV 300 steel is 2.94e9 Pa; a smaller value makes the Archard wear rate k/H overflow)"
+                ),
+            ));
+        }
         positive(
             &format!("{path}.allowable_pressure"),
             self.allowable_pressure,
         )
     }
 }
+
+/// The smallest indentation hardness a material may have [Pa].
+const MIN_HARDNESS: f64 = 1e6;
 
 /// The two contact materials of the paper, and the two solids.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -666,8 +681,21 @@ impl WearSpec {
     ];
 
     fn validate(&self) -> Result<(), SceneError> {
-        non_negative("wear.tube_coefficient", self.tube_coefficient)?;
-        non_negative("wear.internal_coefficient", self.internal_coefficient)
+        for (key, k) in [
+            ("wear.tube_coefficient", self.tube_coefficient),
+            ("wear.internal_coefficient", self.internal_coefficient),
+        ] {
+            non_negative(key, k)?;
+            if k > 1.0 {
+                return Err(SceneError::new(
+                    key,
+                    k,
+                    "must not exceed 1 (Archard's k is the fraction of asperity contacts that make a wear \
+                     particle: 1e-4 dry, 1e-7 lubricated steel)",
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
