@@ -25,14 +25,15 @@ FACADE = "ballcage"
 #: The library, below the CLI: every group but the CLI and the facade.
 _LIBRARY = (
     "_native", "_files", "_plot", "scene", "run", "_links", "duty", "sizing", "buckling", "measures",
-    "view", "studies", "paper",
+    "view", "studies", "verify", "paper",
 )  # fmt: skip
 
 #: The groups, bottom first, each with the groups it may import. The native module (`_native`, Rust) is the
 #: bottom; then the file writers and the plotting style; scenes and runs; the library's models of a run (tube
 #: forces per link, duty, sizing, buckling, the measurements `ballcage.measures`); the studies and the 3D view;
-#: the paper's report; the CLI, one module per command; the facade on top. A group may only import groups above
-#: it in this table, and only those listed (tests below).
+#: a run's verification (`verify`: its error against a run ten times tighter, by the studies' quantities, called
+#: by `run` through the hook `run.VERIFIER` the facade sets); the paper's report; the CLI, one module per command;
+#: the facade on top. A group may only import groups above it in this table, and only those listed (tests below).
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("_native", ()),
     ("_files", ()),
@@ -46,6 +47,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("measures", ("_native", "run", "_links")),
     ("view", ("_native", "_files", "_plot", "run")),
     ("studies", ("_native", "_files", "_plot", "scene", "run", "_links", "sizing", "measures")),
+    ("verify", ("_native", "run", "studies")),
     ("paper", ("_native", "_files", "_plot", "scene", "run", "_links", "duty", "measures", "view", "studies")),
     ("cli", _LIBRARY),
     (FACADE, (*_LIBRARY, "cli")),

@@ -12,8 +12,11 @@ A scene is a TOML file, a dict of the same structure, or a `SceneBuilder`;
 `load_scene` validates it (in Rust) and raises `SceneError` naming the field.
 Every error ballcage raises is a `ballcage.Error`: `SceneError` (a scene field),
 `SimulationError` (a run that diverged), `InputError` (a function argument),
-`InternalError` (a bug: a Rust panic, caught), and the studies' `StudyError`
-and `SweepError`.
+`InternalError` (a bug: a Rust panic, caught), the studies' `StudyError`
+and `SweepError`, and `ballcage.verify.VerificationError` (a `SimulationError`).
+``ballcage.simulate(scene, verify=True)`` repeats the run ten times tighter
+and keeps the difference of each headline quantity as the run's measured
+error, ``run.verification`` (``ballcage run --verify``; `ballcage.verify`).
 All quantities are SI; units are in each output column's field metadata.
 
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
@@ -41,10 +44,16 @@ from ballcage._native import (
     SimulationError,
     table_schema,
 )
+from ballcage import run as _run
+from ballcage import verify as _verify
 from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
 from ballcage.sizing import largest_link_diameter, longest_link, tightest_radius_for_link
+
+# `simulate(..., verify=True)` measures the run's error with `ballcage.verify.verify`, which lies above
+# `ballcage.run` (it takes a drill pipe's quantities from `ballcage.measures`): wired here, on top.
+_run.VERIFIER = lambda run, progress: _verify.verify(run, progress=progress)
 
 __version__: str = _native.__version__
 

@@ -4,14 +4,23 @@ The simulation itself runs in Rust without the GIL. `simulate` advances it in
 about `CHUNKS` pieces so that Ctrl-C is honoured between pieces and a progress
 bar can be drawn; the chunking does not change the result (the integrator
 steps are the same).
+
+``simulate(..., verify=True)`` repeats the run ten times tighter and keeps the
+difference of each headline quantity as the run's measured error
+(`Verification`, ``verify.parquet``). That work is `ballcage.verify.verify`,
+above this module (it takes a drill pipe's quantities from
+`ballcage.measures`); this module calls it through `VERIFIER`, which the
+package's facade (``ballcage/__init__.py``) sets, so it never imports it.
 """
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import time
 from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -22,12 +31,42 @@ from ballcage.scene import SceneSource, load_scene
 if TYPE_CHECKING:
     import pyarrow as pa
 
-__all__ = ["Run", "simulate"]
+__all__ = ["VERIFY_FILE", "Run", "Verification", "simulate"]
 
 #: Number of `advance` calls a run is split into.
 CHUNKS = 200
 #: Wall time [s] after which an automatic progress bar appears.
 PROGRESS_DELAY_S = 1.5
+#: The file `Run.write` writes a run's `Verification` table to.
+VERIFY_FILE = "verify.parquet"
+
+
+@dataclass(frozen=True)
+class Verification:
+    """A run's measured error: the same scene run ten times tighter (`ballcage.verify`).
+
+    `table` holds one row per headline quantity (its value in both runs, their
+    absolute and relative difference; ``ballcage schema``-style units in the
+    field metadata, both runs' wall times in the schema metadata); `Run.write`
+    writes it as ``verify.parquet``.
+    """
+
+    table: pa.Table
+    #: The tighter setting, ``"dt/4"`` or ``"rtol/10"``.
+    setting: str
+    #: The overrides that made the verification run from the run's scene, e.g. ``("simulation.dt=2.5e-05",)``.
+    overrides: tuple[str, ...]
+    #: The largest relative difference over the quantities that have one; ``None`` when none has.
+    largest: float | None
+    #: The quantity of `largest`.
+    quantity: str | None
+    #: Wall time of the verification run over the run's (``ballcage.wall_time_s``); ``None`` if not measured.
+    time_ratio: float | None
+
+
+#: ``VERIFIER(run, progress)`` measures a complete run's error for ``simulate(..., verify=True)``:
+#: `ballcage.verify.verify`, set by the package's facade.
+VERIFIER: Callable[[Run, bool | None], Verification] | None = None
 
 
 class Run:
@@ -44,12 +83,15 @@ class Run:
         *,
         error: str | None = None,
         scene: _native.Scene | None = None,
+        verification: Verification | None = None,
     ) -> None:
         self.tables: dict[str, pa.Table] = dict(tables)
         self._scene_toml = scene_toml
         self._scene = scene
         #: Why the run stopped early (the `SimulationError` message); ``None`` for a complete run.
         self.error: str | None = error
+        #: The run's measured error (``simulate(..., verify=True)``); ``None`` for a run not verified.
+        self.verification: Verification | None = verification
 
     @property
     def bodies(self) -> pa.Table:
@@ -118,7 +160,7 @@ class Run:
         return self._scene
 
     def write(self, directory: str | os.PathLike[str]) -> dict[str, Path]:
-        """Writes ``<table>.parquet`` (zstd) for every table and ``scene.toml`` into `directory`.
+        """Writes ``<table>.parquet`` (zstd) for every table, ``scene.toml`` and ``verify.parquet`` into `directory`.
 
         The directory is created if needed. Each file is written atomically:
         a reader sees either the previous file or the complete new one, and a
@@ -128,8 +170,10 @@ class Run:
         of the folder's files.
         Tables of an earlier run in the same directory that this run did not
         record (``<table>.parquet`` of any table ``ballcage schema`` lists) are
-        removed afterwards, so the folder never mixes two runs; other files
-        are left alone. Returns the written paths, keyed by table name and ``"scene"``.
+        removed afterwards, so the folder never mixes two runs, and so is an
+        earlier ``verify.parquet`` when this run has no `verification`; other
+        files are left alone. Returns the written paths, keyed by table
+        name, ``"scene"`` and ``"verify"``.
         """
         out = Path(directory)
         out.mkdir(parents=True, exist_ok=True)
@@ -142,11 +186,16 @@ class Run:
         scene_path = out / "scene.toml"
         writers[scene_path] = lambda tmp: tmp.write_text(self._scene_toml, encoding="utf-8")
         written["scene"] = scene_path
+        if self.verification is not None:
+            written["verify"] = out / VERIFY_FILE
+            writers[written["verify"]] = parquet_writer(self.verification.table)
         # Every temporary first, then the renames: a failed write (a full disk) leaves the folder as it was.
         write_all_atomically(writers)
         for name in _native.TABLE_NAMES:
             if name not in self.tables:
                 (out / f"{name}.parquet").unlink(missing_ok=True)
+        if self.verification is None:
+            (out / VERIFY_FILE).unlink(missing_ok=True)
         return written
 
     def _table(self, name: str) -> pa.Table:
@@ -170,12 +219,22 @@ def simulate(
     *,
     overrides: Iterable[str] = (),
     progress: bool | None = None,
+    verify: bool = False,
 ) -> Run:
     """Runs a scene to its duration and returns the recorded tables.
 
     `scene` is anything `load_scene` accepts; `overrides` are ``dotted.key=value``
     strings. `progress`: ``None`` shows a bar on stderr once the run has taken
     more than 1.5 s, ``True`` shows it from the start, ``False`` never.
+
+    `verify`: run the scene again ten times tighter (`ballcage.verify.tighter`:
+    ``rtol/10`` for adaptive steps, else ``dt/d`` with d = ceil(10^(1/p)), p the
+    integrator's order) and keep the difference of each headline quantity as
+    the run's measured error in ``Run.verification`` (a `Verification`;
+    ``Run.write`` writes ``verify.parquet``). The headline quantities are a
+    drill pipe's comparison quantities and a generic scene's summary
+    statistics, so a scene that does not record the ``summary`` table records
+    it too. The verification run shows its own progress bar.
 
     Raises `ballcage.SceneError` for an invalid scene and
     `ballcage.SimulationError` when the run diverges. The error then carries
@@ -184,8 +243,23 @@ def simulate(
     ``e.run.write(dir)`` writes it like a complete run. An interrupt
     (Ctrl-C, `KeyboardInterrupt`) is re-raised the same way, carrying the
     frames recorded so far as ``e.run`` (``Run.error`` says when it stopped).
+    When the verification run fails, `ballcage.verify.VerificationError` (a
+    `SimulationError`) carries the complete run, unverified, as ``e.run``; an
+    interrupt during the verification run carries it too.
     """
     resolved = load_scene(scene, overrides)
+    if verify and "summary" not in resolved.table_names:
+        resolved = load_scene(resolved, ["record.tables=" + json.dumps([*resolved.table_names, "summary"])])
+    run = _run(resolved, progress)
+    if verify:
+        if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
+            raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
+        run.verification = VERIFIER(run, progress)
+    return run
+
+
+def _run(resolved: _native.Scene, progress: bool | None) -> Run:
+    """`simulate` of a validated scene, without verification."""
     sim = _native.Simulation(resolved)
     duration = sim.duration
     bar = _ProgressBar(progress, duration)

@@ -10,9 +10,10 @@
 
 use crate::force::friction_force;
 use crate::force::joint::twist_axis;
-use crate::geometry::ContactPoint;
+use crate::geometry::{CentreMotion, ContactPoint, Rim, Slide};
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
+use nalgebra::Vector6;
 use rayon::prelude::*;
 
 /// Accelerations of every body (zero for bodies that are not integrated).
@@ -361,7 +362,7 @@ impl Dynamics {
             self.force[a] -= w.force;
             self.torque[a] -= ra.cross(&w.force) + w.torque;
             if let Some(jac) = jac.as_deref_mut() {
-                jac.add_joint(model.pairs.len() + n, j, state, &ra, &rb);
+                jac.add_joint(model.pairs.len() + n, j, state, (&ra, &rb), &w.force);
             }
         }
         // 3. contacts
@@ -464,9 +465,14 @@ impl Dynamics {
     /// respect to the velocities when the positions move with them as
     /// x = x₀ + s·v (an implicit stage of weight s). K holds the normal
     /// stiffness of each contact point (∂F_n/∂δ along the normal, with the
-    /// friction it carries) and the joint springs; the
-    /// geometric terms (normals and lever arms turning with the bodies) are
-    /// left out, which Newton iterations tolerate.
+    /// friction it carries), the joint springs, and the geometric terms of
+    /// the normal forces and the joint springs: normals turning across the
+    /// curved surfaces and with the bodies, lever arms turning with the
+    /// bodies ([`crate::geometry::NormalTurning`]). Left out: the friction
+    /// force's turning, the damping and slip's dependence on the pose (both
+    /// vanish at rest), the twist spring's axis turning, and a contact
+    /// point's sliding along a link or a ring (tests/jacobian.rs measures
+    /// what each leaves: 2 % of the link–tube and neck–ring stiffness).
     pub fn forces_and_jacobian(
         &mut self,
         model: &Model,
@@ -637,6 +643,7 @@ fn find_points(model: &Model, pair: &ContactPair, state: &State, out: &mut Vec<C
     if pair.swapped {
         for p in out.iter_mut() {
             p.normal = -p.normal;
+            p.turning = p.turning.swapped();
         }
     }
 }
@@ -768,6 +775,88 @@ impl CouplingJacobian {
             let p = e.point.point;
             self.add_gradient(&g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
         }
+        if scale != 0.0 && e.normal_force != 0.0 {
+            self.add_turning(state, pair, e, scale, scale * d.d_depth);
+        }
+    }
+
+    /// Adds s times the geometric stiffness of point `e`'s normal force
+    /// F·n̂ ([`crate::geometry::NormalTurning`]): the normal turning as the centre c moves
+    /// across the field (curvature H) and with the field's body, and the
+    /// lever arms c − x turning with the bodies.
+    ///
+    /// With P the body carrying c (force F_P = σ·F·n̂ on it, σ = +1 for b)
+    /// and Q the field's, a pose change [δx; δθ] (world) gives
+    /// δn̂ = −[n̂]×·δθ_Q + H·(J_P(c)·δq_P − J_Q(c)·δq_Q), and besides
+    /// σF·δn̂ at the arms r_i = c − x_i the torques gain
+    /// δτ_P = [F_P]×[r_P]×·δθ_P and δτ_Q = [F_P]×·(δx_P − [r_P]×·δθ_P − δx_Q).
+    /// The friction force's turning is left out (it is μ times smaller and
+    /// vanishes at rest). `k` = s·∂F_n/∂δ, for a centre that moves on its
+    /// body into or out of the wall ([`CentreMotion::Rim`]).
+    fn add_turning(&mut self, state: &State, pair: &ContactPair, e: &ContactEval, s: f64, k: f64) {
+        let t = &e.point.turning;
+        let n = e.point.normal;
+        let (p, q, sigma) = if t.centre_on_b {
+            (pair.b, pair.a, 1.0)
+        } else {
+            (pair.a, pair.b, -1.0)
+        };
+        let f = s * sigma * e.normal_force;
+        let (rp, rq) = (t.centre - state.pos[p], t.centre - state.pos[q]);
+        let g = f * t.curvature;
+        let mut pp = wrench_twist_block(&rp, &g, &rp);
+        let mut pq = -wrench_twist_block(&rp, &g, &rq);
+        let mut qp = -wrench_twist_block(&rq, &g, &rp);
+        let mut qq = wrench_twist_block(&rq, &g, &rq);
+        // The field turning with Q: δF_P = −f·[n̂]×·δθ_Q.
+        let turn = -f * n.cross_matrix();
+        let (rpx, rqx) = (rp.cross_matrix(), rq.cross_matrix());
+        add3(&mut pq, 0, 3, &turn);
+        add3(&mut pq, 3, 3, &(rpx * turn));
+        add3(&mut qq, 0, 3, &(-turn));
+        add3(&mut qq, 3, 3, &(-(rqx * turn)));
+        // The arms.
+        let fx = (f * n).cross_matrix();
+        add3(&mut pp, 3, 3, &(fx * rpx));
+        add3(&mut qq, 3, 0, &(-fx));
+        add3(&mut qp, 3, 0, &fx);
+        add3(&mut qp, 3, 3, &(-(fx * rpx)));
+        let blocks = [&mut pp, &mut pq, &mut qp, &mut qq];
+        match &t.motion {
+            CentreMotion::Fixed => {}
+            CentreMotion::Slides(slide) => {
+                add_slide(blocks, slide, &t.curvature, &n, f, (&rp, &rq));
+            }
+            CentreMotion::Rim(rim) => {
+                // ∂F_P/∂(c's own motion): the normal turning, and the depth
+                // with the friction it carries.
+                let along = if e.normal_force != 0.0 {
+                    n + e.tangential_force / e.normal_force
+                } else {
+                    n
+                };
+                let g = f * t.curvature - k * along * n.transpose();
+                let (xp, xq) = (state.pos[p], state.pos[q]);
+                add_rim(
+                    blocks,
+                    rim,
+                    &g,
+                    &(f * n),
+                    (&rp, &rq),
+                    (&(rim.end - xp), &(rim.end - xq)),
+                );
+            }
+        }
+        self.active = true;
+        let (on_p, on_q) = if t.centre_on_b {
+            ([&mut self.bb, &mut self.ba], [&mut self.ab, &mut self.aa])
+        } else {
+            ([&mut self.aa, &mut self.ab], [&mut self.ba, &mut self.bb])
+        };
+        *on_p[0] += pp;
+        *on_p[1] += pq;
+        *on_q[0] += qp;
+        *on_q[1] += qq;
     }
 }
 
@@ -854,13 +943,30 @@ impl VelocityJacobian {
     /// (arms `ra`, `rb`) and −c_t·(ê·(ω_b − ω_a))·ê on b about the mean x
     /// axis ê ([`twist_axis`]).
     ///
-    /// With a stiffness scale s the springs add s·k in the same places.
-    fn add_joint(&mut self, k: usize, j: &Joint, state: &State, ra: &Vec3, rb: &Vec3) {
+    /// With a stiffness scale s the springs add s·k in the same places, and
+    /// the arms of the joint's force F on b (−F on a) turn with the bodies:
+    /// δτ_b = [F]×[r_b]×·δθ_b, δτ_a = −[F]×[r_a]×·δθ_a.
+    fn add_joint(
+        &mut self,
+        k: usize,
+        j: &Joint,
+        state: &State,
+        arms: (&Vec3, &Vec3),
+        force: &Vec3,
+    ) {
+        let (ra, rb) = arms;
         let p = &j.params;
         let s = self.stiffness_scale;
         let linear = p.damping + s * p.stiffness;
         if linear != 0.0 {
             self.add_gradient(k, &(-linear * Mat3::identity()), ra, rb);
+        }
+        if s != 0.0 && *force != Vec3::zeros() {
+            let fx = (s * force).cross_matrix();
+            let c = &mut self.couplings[k];
+            c.active = true;
+            add3(&mut c.bb, 3, 3, &(fx * rb.cross_matrix()));
+            add3(&mut c.aa, 3, 3, &(-(fx * ra.cross_matrix())));
         }
         let twist = p.twist_damping + s * p.twist_stiffness;
         if twist != 0.0 {
@@ -897,6 +1003,104 @@ fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives, s: f64) -> M
         g -= normal * along * n.transpose();
     }
     g
+}
+
+/// Adds to the blocks [PP, PQ, QP, QQ] of [`CouplingJacobian::add_turning`]
+/// the sliding of the centre c along `slide` (its [`Slide`]): c moves by
+/// â·δs, which turns the normal by H·â·δs and moves both arms by â·δs, a
+/// rank-one term (wrench per unit slide) ⊗ (∂s/∂pose). `f` is the scaled,
+/// signed force on P along `n`, `arms` (r_P, r_Q). A slide along which the
+/// normal does not turn (âᵀH·â + n·κ = 0: a link parallel to a straight
+/// wall) has no definite position and adds nothing.
+fn add_slide(
+    blocks: [&mut Mat6; 4],
+    slide: &Slide,
+    h: &Mat3,
+    n: &Vec3,
+    f: f64,
+    (rp, rq): (&Vec3, &Vec3),
+) {
+    let a = slide.direction;
+    let ha = h * a;
+    let den = a.dot(&ha) + n.dot(&slide.curvature);
+    if den.abs() <= 1e-12 * (h.norm() + slide.curvature.norm()) {
+        return;
+    }
+    let hta = h.transpose() * a;
+    let axn = a.cross(n);
+    let row = |r: &Vec3, sign: f64| {
+        let (x, th) = (sign * hta, sign * (r.cross(&hta) + axn));
+        Vector6::new(x.x, x.y, x.z, th.x, th.y, th.z) / -den
+    };
+    let (g, fp) = (f * ha, f * n);
+    let wrench = |r: &Vec3, sign: f64| {
+        let t = sign * (r.cross(&g) - fp.cross(&a));
+        Vector6::new(sign * g.x, sign * g.y, sign * g.z, t.x, t.y, t.z)
+    };
+    let (row_p, row_q) = (row(rp, 1.0), row(rq, -1.0));
+    let (w_p, w_q) = (wrench(rp, 1.0), wrench(rq, -1.0));
+    let [pp, pq, qp, qq] = blocks;
+    *pp += w_p * row_p.transpose();
+    *pq += w_p * row_q.transpose();
+    *qp += w_q * row_p.transpose();
+    *qq += w_q * row_q.transpose();
+}
+
+/// Adds to the blocks [PP, PQ, QP, QQ] of [`CouplingJacobian::add_turning`]
+/// the motion of a rim point around its rim ([`Rim`]): c moves on P by
+/// e = M_P·δq_P + M_Q·δq_Q, and the wrenches change by W_P·e (on P) and
+/// W_Q·e (on Q), with `g` = ∂F_P/∂e (the normal turning and the depth),
+/// `fp` the scaled force on P, `arms` (c − x_P, c − x_Q) and `ends`
+/// (q − x_P, q − x_Q).
+fn add_rim(
+    blocks: [&mut Mat6; 4],
+    rim: &Rim,
+    g: &Mat3,
+    fp: &Vec3,
+    (rp, rq): (&Vec3, &Vec3),
+    (qp, qq): (&Vec3, &Vec3),
+) {
+    let (a, u) = (rim.axis, rim.offset);
+    let pi = Mat3::identity() - a * a.transpose();
+    let across = pi * u;
+    let len = across.norm();
+    if len <= 1e-15 {
+        return;
+    }
+    let d = across / len;
+    let turn = (rim.radius / len) * (Mat3::identity() - d * d.transpose());
+    let pa = pi * (Mat3::identity() - rim.beta * rim.core_tangent * rim.core_tangent.transpose());
+    let grow = u.dot(&a);
+    // ∂e/∂(δx, δθ) of P and of Q.
+    let mut mp = nalgebra::Matrix3x6::zeros();
+    mp.fixed_view_mut::<3, 3>(0, 0).copy_from(&(turn * pa));
+    let rot_p = -(pa * qp.cross_matrix()) + grow * a.cross_matrix() - a * a.cross(&u).transpose();
+    mp.fixed_view_mut::<3, 3>(0, 3)
+        .copy_from(&(turn * rot_p + rim.radius * d.cross_matrix()));
+    let mut mq = nalgebra::Matrix3x6::zeros();
+    mq.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-(turn * pa)));
+    let rot_q = pa * qq.cross_matrix() - pi * u.cross_matrix();
+    mq.fixed_view_mut::<3, 3>(0, 3).copy_from(&(turn * rot_q));
+    let fx = fp.cross_matrix();
+    let wrench = |r: &Vec3, sign: f64| {
+        let mut w = nalgebra::Matrix6x3::zeros();
+        w.fixed_view_mut::<3, 3>(0, 0).copy_from(&(sign * g));
+        w.fixed_view_mut::<3, 3>(3, 0)
+            .copy_from(&(sign * (r.cross_matrix() * g - fx)));
+        w
+    };
+    let (w_p, w_q) = (wrench(rp, 1.0), wrench(rq, -1.0));
+    let [pp, pq, qp_block, qq_block] = blocks;
+    *pp += w_p * mp;
+    *pq += w_p * mq;
+    *qp_block += w_q * mp;
+    *qq_block += w_q * mq;
+}
+
+/// Adds `m` to the 3×3 block of `to` at (`row`, `col`).
+fn add3(to: &mut Mat6, row: usize, col: usize, m: &Mat3) {
+    let mut v = to.fixed_view_mut::<3, 3>(row, col);
+    v += m;
 }
 
 /// W_i·G·J_j: the wrench on body i (force G·u at arm r_i) per unit twist of

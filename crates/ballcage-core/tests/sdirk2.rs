@@ -54,10 +54,13 @@ const PRESSED: &str = r#"
 #[test]
 fn stiffness_jacobian_matches_finite_differences() {
     // K = (J(s) − J(0))/s against central differences of the force on each
-    // ball with respect to its translation. On the half-space the whole
-    // translational block is exact (the normal does not move with the ball,
-    // and without spin the slip does not depend on the arm); in the groove the normal turns with a sideways move, a
-    // geometric term K leaves out, so only the normal–normal entry is exact.
+    // ball with respect to its translation. On the half-space the normal
+    // does not move with the ball, and without spin the slip does not depend
+    // on the arm, so the whole translational block is exact. The key in the
+    // groove is moving: the pose dependence of its damping and slip, which
+    // K leaves out, shows in the sideways entries (about 1 % here), so only
+    // the normal–normal entry is exact. tests/jacobian.rs checks every pair
+    // kind at rest, where K is exact with its geometric terms.
     let sim = common::sim(PRESSED);
     let model = sim.model();
     let state = sim.state().clone();

@@ -11,6 +11,9 @@ pub struct CentrelinePoint {
     pub point: Vector,
     /// Unit tangent there.
     pub tangent: Vector,
+    /// Curvature vector κ·N̂ [1/m]: toward the centre of the osculating
+    /// circle, 1/radius long; zero on a straight segment.
+    pub curvature: Vector,
 }
 
 /// A lumen around a centreline: the wall is `wall_radius` from it.

@@ -97,6 +97,7 @@ impl Centreline for GrooveFlank {
         Some(CentrelinePoint {
             point: self.centre + self.core_radius * dir,
             tangent: self.axis.cross(dir),
+            curvature: -dir / self.core_radius,
         })
     }
 

@@ -103,6 +103,7 @@ impl PointQuery for GrooveFlank {
             crate::centreline::CentrelinePoint {
                 point: self.centre + self.core_radius * dir,
                 tangent: self.axis.cross(dir),
+                curvature: -dir / self.core_radius,
             }
         });
         (

@@ -150,6 +150,7 @@ impl TubeInterior {
                         return CentrelinePoint {
                             point: start + rest.min(length) * dir,
                             tangent: dir,
+                            curvature: Vector::ZERO,
                         };
                     }
                     rest -= length;
@@ -165,9 +166,11 @@ impl TubeInterior {
                     let seg_len = radius * angle;
                     if rest <= seg_len || last {
                         let th = (rest / radius).min(angle);
+                        let out = th.cos() * u + th.sin() * t;
                         return CentrelinePoint {
-                            point: center + radius * (th.cos() * u + th.sin() * t),
+                            point: center + radius * out,
                             tangent: -th.sin() * u + th.cos() * t,
+                            curvature: -out / radius,
                         };
                     }
                     rest -= seg_len;
@@ -177,6 +180,7 @@ impl TubeInterior {
         CentrelinePoint {
             point: self.end,
             tangent: self.end_dir,
+            curvature: Vector::ZERO,
         }
     }
 
@@ -321,6 +325,7 @@ pub(crate) fn nearest_on_segment(seg: &Segment, q: Vector) -> CentrelinePoint {
             CentrelinePoint {
                 point: start + s * dir,
                 tangent: dir,
+                curvature: Vector::ZERO,
             }
         }
         Segment::Arc {
@@ -362,6 +367,7 @@ pub(crate) fn nearest_on_segment(seg: &Segment, q: Vector) -> CentrelinePoint {
             CentrelinePoint {
                 point: center + radius * (c * u + s * t),
                 tangent: -s * u + c * t,
+                curvature: -(c * u + s * t) / radius,
             }
         }
     }

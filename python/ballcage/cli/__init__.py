@@ -19,8 +19,9 @@ lists them); each parses its options and calls the library:
 adders and checks, and the loading of the command line's scene.
 
 Exit codes: 0 success; 1 the run diverged (`SimulationError`; ``ballcage run``
-then still writes what was recorded, marked incomplete), a study failed, or a
-sweep case or chart cell did not finish; 2 bad input (an invalid scene, a TOML
+then still writes what was recorded, marked incomplete), the verification run
+of ``ballcage run --verify`` failed (the run's own tables written), a study
+failed, or a sweep case or chart cell did not finish; 2 bad input (an invalid scene, a TOML
 syntax error, a missing file, a malformed ``--set``, an unknown ``--tables``
 name, an ``--out`` folder holding another run, an option value the library
 refused, a usage error); 3 the output could not be written; 70 internal error

@@ -21,7 +21,8 @@ from ballcage.cli._common import (
     load_cli_scene,
     names,
 )
-from ballcage.run import simulate
+from ballcage.run import VERIFY_FILE, Run, simulate
+from ballcage.verify import VerificationError, disagreements, verdict
 
 
 def add(commands: Commands) -> None:
@@ -55,6 +56,16 @@ def add(commands: Commands) -> None:
             "describes them); default: the scene's record.tables"
         ),
     )
+    run.add_argument(
+        "--verify",
+        action="store_true",
+        help=(
+            "repeat the run ten times tighter (dt/d with d = ceil(10^(1/order)), e.g. dt/4 for sdirk2; rtol/10 for "
+            "adaptive steps), write the difference of each headline quantity (a drill pipe's comparison quantities, "
+            "a generic scene's summary statistics) to verify.parquet and end with the largest: the run's measured "
+            "error; a failed verification run exits 1, the run's own tables written"
+        ),
+    )
     add_set_option(run)
     add_quiet_option(run, "no progress bar and no summary")
     run.set_defaults(command=command)
@@ -78,36 +89,57 @@ def command(args: argparse.Namespace) -> int:
         except UsageError as e:  # the scene loaded without the tables: they are what it refuses
             raise UsageError(f"--tables {','.join(tables)}: {e}") from e
     try:
-        result = simulate(scene, progress=False if args.quiet else None)
+        result = simulate(scene, progress=False if args.quiet else None, verify=args.verify)
     except (_native.SimulationError, KeyboardInterrupt) as e:
         partial = getattr(e, "run", None)
         if partial is None:
             raise
-        paths = partial.write(out)
-        if not args.quiet:
-            for name, path in paths.items():
-                print(_summary(name, path, partial.tables.get(name)))
-        code = 130 if isinstance(e, KeyboardInterrupt) else 1
-        return fail(f"{partial.error}; the output in {out} is incomplete (written up to then, ballcage.complete = false)", code)
-    paths = result.write(out)
+        _write(partial, out, args.quiet)
+        return _failed(e, partial, out)
+    _write(result, out, args.quiet)
     if not args.quiet:
-        for name, path in paths.items():
-            print(_summary(name, path, result.tables.get(name)))
-        print(_cost(result.metadata))
-        if "wear" in result.tables:
-            from ballcage.duty import margin_line, wear_line
-
-            for line in (margin_line(result.tables["wear"]), wear_line(result.tables["wear"])):
-                if line is not None:
-                    print(f"ballcage: {line}")
-        if result.fallback_note is not None:
-            print(f"ballcage: warning: {result.fallback_note}")
+        _report(result)
     return 0
 
 
+def _write(result: Run, out: Path, quiet: bool) -> None:
+    """Writes `result` into `out` and, unless `quiet`, prints one line per file."""
+    paths = result.write(out)
+    if not quiet:
+        for name, path in paths.items():
+            table = result.verification.table if name == "verify" and result.verification else result.tables.get(name)
+            print(_summary(name, path, table))
+
+
+def _failed(error: BaseException, written: Run, out: Path) -> int:
+    """The exit code and message of a run that stopped (`written` is what was written) or whose verification failed."""
+    code = 130 if isinstance(error, KeyboardInterrupt) else 1
+    if isinstance(error, VerificationError) or (isinstance(error, KeyboardInterrupt) and written.complete):
+        reason = error if isinstance(error, VerificationError) else "interrupted during the verification run"
+        return fail(f"{reason}; the run's own tables in {out} are complete, {VERIFY_FILE} was not written", code)
+    return fail(f"{written.error}; the output in {out} is incomplete (written up to then, ballcage.complete = false)", code)
+
+
+def _report(result: Run) -> None:
+    """The lines after the files: the run's cost, wear, fallback steps and, last, its verification."""
+    print(_cost(result.metadata))
+    if "wear" in result.tables:
+        from ballcage.duty import margin_line, wear_line
+
+        for line in (margin_line(result.tables["wear"]), wear_line(result.tables["wear"])):
+            if line is not None:
+                print(f"ballcage: {line}")
+    if result.fallback_note is not None:
+        print(f"ballcage: warning: {result.fallback_note}")
+    if result.verification is not None:
+        for line in disagreements(result.verification):
+            print(f"ballcage: warning: {line}")
+        print(verdict(result.verification))
+
+
 def _earlier_run(out: Path) -> list[str]:
-    """Files of an earlier run in `out`: its ``<table>.parquet`` and ``scene.toml``."""
-    files = [f"{t}.parquet" for t in _native.TABLE_NAMES] + ["scene.toml"]
+    """Files of an earlier run in `out`: its ``<table>.parquet``, ``scene.toml`` and ``verify.parquet``."""
+    files = [f"{t}.parquet" for t in _native.TABLE_NAMES] + ["scene.toml", VERIFY_FILE]
     return [n for n in files if (out / n).exists()]
 
 

@@ -248,8 +248,11 @@ pub struct PipeSpec {
     /// Sample points along each link (rims included) that bracket the
     /// extrema of its depth in the tube (or, with `"patches"`, locate its
     /// contact patches); the force does not depend on this count once each
-    /// extremum has a bracket of its own. PROPOSAL: 33 (6.25 mm apart):
-    /// the compared quantities agree within 0.1 % from 5 samples up, but a
+    /// extremum has a bracket of its own. PROPOSAL: 33 (6.25 mm apart). On
+    /// the paper run (SDIRK2 at 100 µs for every count) the compared
+    /// quantities at 5 samples agree with those at 17 within 0.08 % (link
+    /// 10's peak tube force within 1.2 %), and at 17 with those at 33 within
+    /// 0.012 %: the sample count's effect, not the run's error. But a
     /// maximum–minimum pair hidden between two samples joins the law with a
     /// finite step when it reaches a sample, and those steps cost the
     /// implicit integrator step halvings (over the paper's first 1.2 s:
@@ -733,10 +736,13 @@ pub struct DrillPipeSpec {
     #[serde(skip_serializing_if = "String::is_empty")]
     pub name: String,
     /// Time stepping. The paper's 1 ms is the output interval, not the step.
-    /// Default: SDIRK2 at 100 µs: against a converged reference, every
-    /// time-averaged force and peak of `ballcage accuracy` within 0.21 %, an
-    /// instantaneous bend of a nearly straight link within 5 %
-    /// (docs/accuracy.md). Explicit
+    /// Default: SDIRK2 at fixed steps of 100 µs. Its error on the present
+    /// model (level-set tube law, 33 samples) is not measured; on the
+    /// patch-law model of 2026-11-23 SDIRK2 at 200, 100 and 50 µs had largest
+    /// errors of 0.52 %, 5.0 % and 0.52 % (the final bend of a nearly
+    /// straight link), not falling with the step (docs/accuracy.md, "What a
+    /// run's accuracy is today"). `ballcage run --verify` and `ballcage
+    /// accuracy` measure a run's error. Explicit
     /// integrators need 0.1 µs here: at 1 µs the lubricated key friction (a
     /// damper of rate ~4e6 1/s at 10 kN) chatters, and even 0.2 µs drifts
     /// once the keys carry their full load (docs/paper.md).

@@ -25,11 +25,15 @@
 //! stays as [`LineLaw::Patches`] for comparison
 //! (`ballcage_shapes::line::line_patches`).
 
-use ballcage_shapes::Rod;
 use ballcage_shapes::line::{Ends, line_extrema, line_patches};
+use ballcage_shapes::{Rod, TubeInterior};
+use parry3d_f64::math::Vector;
 
-use super::{ContactPoint, LineContact, LineLaw, TubePath};
+use super::{
+    CentreMotion, ContactPoint, LineContact, LineLaw, NormalTurning, Rim, Slide, TubePath,
+};
 use crate::math::{Quat, Vec3, from_glam, to_glam};
+use ballcage_shapes::line::Extremum;
 
 /// Contact points of a cylinder (`radius`, `half_length`, axis along its
 /// body x) at pose `pc` inside tube `t` at pose `pt`, by the `line`
@@ -51,13 +55,18 @@ pub(super) fn cylinder_tube(
         half_length,
         radius,
     };
-    let mut push = |c: ballcage_shapes::LocalContact, weight: f64| {
+    let inside = t.interior();
+    let mut push = |c: ballcage_shapes::LocalContact, kind: Option<Extremum>| {
+        let weight = kind.map_or(1.0, Extremum::weight);
+        let normal = pt.1 * from_glam(c.normal);
+        let turning = turning(&c, kind, &rod, inside, pt);
         out.push(ContactPoint {
             slot: c.feature,
             point: pt.0 + pt.1 * from_glam(c.point),
-            normal: pt.1 * from_glam(c.normal),
+            normal,
             depth: c.depth,
             weight,
+            turning,
         })
     };
     match line.law {
@@ -67,14 +76,82 @@ pub(super) fn cylinder_tube(
             Ends::Flat,
             line.points,
             0.0,
-            &mut |c, kind| push(c, kind.weight()),
+            &mut |c, kind| push(c, Some(kind)),
         ),
         LineLaw::Patches => {
             line_patches(t.interior(), &rod, Ends::Flat, line.points, 0.0, &mut |c| {
-                push(c, 1.0)
+                push(c, None)
             })
         }
     }
+}
+
+/// How the normal of contact `c` (tube frame, an extremum of `kind`, or
+/// the patch law's point) of `rod` in the tube `inside` at pose `pt` turns.
+fn turning(
+    c: &ballcage_shapes::LocalContact,
+    kind: Option<Extremum>,
+    rod: &Rod,
+    inside: &TubeInterior,
+    pt: (&Vec3, &Quat),
+) -> NormalTurning {
+    // The lumen's normal field at the point (tube frame) through which the
+    // normal force acts.
+    let normal = pt.1 * from_glam(c.normal);
+    let field = |centre: Vector| match inside.nearest(centre) {
+        Some(core) => NormalTurning::lumen(
+            pt.0 + pt.1 * from_glam(centre),
+            &normal,
+            (centre - core.point).length(),
+            &(pt.1 * from_glam(core.tangent)),
+            &(pt.1 * from_glam(core.curvature)),
+        ),
+        None => NormalTurning::plane(pt.0 + pt.1 * from_glam(centre)),
+    };
+    match kind {
+        // A rim: the force acts through the rim point w, δ/2 behind the
+        // midpoint, which moves around the rim.
+        Some(Extremum::End) => {
+            let mut turning = field(c.point - 0.5 * c.depth * c.normal);
+            let s = if c.feature == 0 {
+                -rod.half_length
+            } else {
+                rod.half_length
+            };
+            turning.motion = rim(rod, s, inside, pt);
+            turning
+        }
+        // Otherwise through the axis point, (r − δ/2) beyond the midpoint
+        // along n (for the patch law's centroid, the link's section there
+        // taken as a ball); an interior extremum slides along the axis.
+        _ => {
+            let mut turning = field(c.point + (rod.radius - 0.5 * c.depth) * c.normal);
+            if kind.is_some() {
+                turning.motion = CentreMotion::Slides(Slide {
+                    direction: pt.1 * from_glam(rod.axis),
+                    curvature: Vec3::zeros(),
+                });
+            }
+            turning
+        }
+    }
+}
+
+/// The rim of `rod`'s end at `s` [m] in the tube `inside` (pose `pt`).
+fn rim(rod: &Rod, s: f64, inside: &TubeInterior, pt: (&Vec3, &Quat)) -> CentreMotion {
+    let q = rod.at(s);
+    let Some(core) = inside.nearest(q) else {
+        return CentreMotion::Fixed;
+    };
+    let u = q - core.point;
+    CentreMotion::Rim(Rim {
+        end: pt.0 + pt.1 * from_glam(q),
+        axis: pt.1 * from_glam(rod.axis),
+        radius: rod.radius,
+        offset: pt.1 * from_glam(u),
+        core_tangent: pt.1 * from_glam(core.tangent),
+        beta: 1.0 / (1.0 - u.dot(core.curvature)),
+    })
 }
 
 #[cfg(test)]

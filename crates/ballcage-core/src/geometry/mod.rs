@@ -37,7 +37,7 @@ use ballcage_shapes::{GrooveFlank, LocalContact, SphericalCavity, WindowSlot};
 use parry3d_f64::query;
 use parry3d_f64::shape::{Ball, Cuboid, HalfSpace};
 
-use crate::math::{Quat, Vec3, from_glam, to_glam, to_glam_pose};
+use crate::math::{Mat3, Quat, Vec3, from_glam, to_glam, to_glam_pose};
 
 /// A shape ready for queries.
 #[derive(Debug, Clone)]
@@ -106,6 +106,121 @@ pub struct ContactPoint {
     /// where the point law is subtracted (−1). Forces, their derivatives
     /// and the elastic energy of the point are multiplied by it.
     pub weight: f64,
+    /// How the normal turns as the bodies move, for the geometric terms
+    /// of the Jacobian.
+    pub turning: NormalTurning,
+}
+
+/// How a contact point's normal turns as the bodies move: the data of the
+/// geometric terms of the force Jacobian (`dynamics::CouplingJacobian`).
+///
+/// The normal force acts along the normal through `centre`, a point c fixed
+/// in one body (a ball's centre, a cuboid's vertex, the axis point of a
+/// link's section, a ring's point); the normal is a field n(c) carried by
+/// the other body. With that body held, `curvature` is ∂n/∂c. For c inside
+/// a lumen at distance ρ from its core curve (nearest point P, unit tangent
+/// t̂, curvature vector κ): n = −(c − P)/ρ and
+/// ∂n/∂c = −(I − n·nᵀ − β·t̂·t̂ᵀ)/ρ with β = 1/(1 − (c − P)·κ) (β = 0 for
+/// a spherical cavity, β = R/|c⊥| for a torus of core radius R); zero for
+/// a plane. Where c also moves on its body as the bodies move (a link's
+/// interior depth extremum along the link's axis, the ring point nearest a
+/// neck's axis along the ring, a link's rim point), `motion` says how.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalTurning {
+    /// The point c [m], world frame.
+    pub centre: Vec3,
+    /// ∂n/∂c [1/m], world frame, the body carrying the field held.
+    pub curvature: Mat3,
+    /// Whether c is carried by body b (and the field by a); else by a.
+    pub centre_on_b: bool,
+    /// How c moves on its body beyond moving with it.
+    pub motion: CentreMotion,
+}
+
+/// How a contact's centre c moves on the body carrying it, beyond moving
+/// with that body.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum CentreMotion {
+    /// c is a material point of its body.
+    #[default]
+    Fixed,
+    /// c slides along a curve where the normal is perpendicular to it.
+    Slides(Slide),
+    /// c is a flat rod end's rim point in a lumen.
+    Rim(Rim),
+}
+
+/// A flat rod end's rim point in a lumen (`ballcage_shapes::line`): with q
+/// the end's axis point, â the axis, u = q − P(q) its offset from the
+/// core curve and d the unit part of u across â, the rim point is
+/// w = q + r·d. As the bodies move, d turns on the rod's end face:
+/// δd = (I − d·dᵀ)/|Π·u| · δ(Π·u), Π = I − â·âᵀ, with
+/// δu = (I − β·t̂·t̂ᵀ)·δq_rel + δθ_lumen × u and δâ = δθ_rod × â.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rim {
+    /// The end's axis point q [m], world frame.
+    pub end: Vec3,
+    /// The rod's unit axis â, world frame.
+    pub axis: Vec3,
+    /// The rod's radius r [m].
+    pub radius: f64,
+    /// u = q − P(q) [m], world frame.
+    pub offset: Vec3,
+    /// Unit tangent t̂ of the core curve at P(q), world frame.
+    pub core_tangent: Vec3,
+    /// β = 1/(1 − u·κ) at P(q), κ the core's curvature vector.
+    pub beta: f64,
+}
+
+/// The curve on its body along which a contact's centre c slides: c stays
+/// where the normal is perpendicular to the curve, n·â = 0, so a pose
+/// change moves c along â by
+/// δs = −(âᵀH·δu + (â × n)·(δθ_c − δθ_field)) / (âᵀH·â + n·κ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Slide {
+    /// Unit tangent â of the curve at c, world frame.
+    pub direction: Vec3,
+    /// Curvature vector κ of the curve at c [1/m], world frame (zero for a
+    /// straight axis).
+    pub curvature: Vec3,
+}
+
+impl NormalTurning {
+    /// c carried by b with a constant normal field (a plane of a).
+    pub fn plane(centre: Vec3) -> Self {
+        Self {
+            centre,
+            curvature: Mat3::zeros(),
+            centre_on_b: true,
+            motion: CentreMotion::Fixed,
+        }
+    }
+
+    /// c carried by b inside a lumen of a: at distance `rho` [m] from the
+    /// core's nearest point, whose unit tangent is `tangent` and curvature
+    /// vector `kappa` [1/m] (zero tangent for a spherical cavity); `normal`
+    /// = −(c − P)/ρ.
+    pub fn lumen(centre: Vec3, normal: &Vec3, rho: f64, tangent: &Vec3, kappa: &Vec3) -> Self {
+        let beta = 1.0 / (1.0 + rho * normal.dot(kappa));
+        let across =
+            Mat3::identity() - normal * normal.transpose() - beta * tangent * tangent.transpose();
+        Self {
+            centre,
+            curvature: -across / rho,
+            centre_on_b: true,
+            motion: CentreMotion::Fixed,
+        }
+    }
+
+    /// The same turning seen from the pair in the other order (normal reversed).
+    pub fn swapped(self) -> Self {
+        Self {
+            centre: self.centre,
+            curvature: -self.curvature,
+            centre_on_b: !self.centre_on_b,
+            motion: self.motion,
+        }
+    }
 }
 
 /// How a cylinder–tube pair turns its line contact into points
@@ -342,13 +457,41 @@ fn parry_convex(
     if let Ok(Some(c)) = query::contact(&pose1, g1, &pose2, g2, 0.0)
         && c.dist < 0.0
     {
+        let normal = from_glam(c.normal1);
         out.push(ContactPoint {
             slot: 0,
             point: 0.5 * (from_glam(c.point1) + from_glam(c.point2)),
-            normal: from_glam(c.normal1),
+            normal,
             depth: -c.dist,
             weight: 1.0,
+            turning: parry_turning(s1, p1, s2, p2, &normal),
         });
+    }
+}
+
+/// The turning of a parry pair's normal: about ball 1's centre for two
+/// balls; a plane's, or a cuboid face's, is constant (a cuboid's edge or
+/// vertex against a ball is left flat).
+fn parry_turning(
+    s1: &Shape,
+    p1: (&Vec3, &Quat),
+    s2: &Shape,
+    p2: (&Vec3, &Quat),
+    normal: &Vec3,
+) -> NormalTurning {
+    match (s1, s2) {
+        (Shape::Ball(_), Shape::Ball(_)) => {
+            let rho = (p2.0 - p1.0).norm();
+            let across = Mat3::identity() - normal * normal.transpose();
+            NormalTurning {
+                centre: *p2.0,
+                curvature: across / rho,
+                centre_on_b: true,
+                motion: CentreMotion::Fixed,
+            }
+        }
+        (Shape::Ball(_), _) => NormalTurning::plane(*p1.0).swapped(),
+        _ => NormalTurning::plane(*p2.0),
     }
 }
 
@@ -386,20 +529,31 @@ fn cuboid_half_space(
                 normal: -n,
                 depth: -d,
                 weight: 1.0,
+                // The vertex (on the cuboid, 1) against the plane of 2.
+                turning: NormalTurning::plane(v).swapped(),
             });
         }
     }
 }
 
 /// A contact in the frame of body a (pose `pa`) as a world contact point,
-/// if the surfaces overlap.
-fn placed(c: LocalContact, pa: (&Vec3, &Quat)) -> Option<ContactPoint> {
-    (c.depth > 0.0).then(|| ContactPoint {
-        slot: c.feature,
-        point: pa.0 + pa.1 * from_glam(c.point),
-        normal: pa.1 * from_glam(c.normal),
-        depth: c.depth,
-        weight: 1.0,
+/// if the surfaces overlap, with the turning `turning(normal)` of its world
+/// normal.
+fn placed(
+    c: LocalContact,
+    pa: (&Vec3, &Quat),
+    turning: impl FnOnce(&Vec3) -> NormalTurning,
+) -> Option<ContactPoint> {
+    (c.depth > 0.0).then(|| {
+        let normal = pa.1 * from_glam(c.normal);
+        ContactPoint {
+            slot: c.feature,
+            point: pa.0 + pa.1 * from_glam(c.point),
+            normal,
+            depth: c.depth,
+            weight: 1.0,
+            turning: turning(&normal),
+        }
     })
 }
 
@@ -410,9 +564,17 @@ fn ball_tube(
     pb: (&Vec3, &Quat),
     out: &mut Vec<ContactPoint>,
 ) {
-    let centre = pt.1.inverse() * (pb.0 - pt.0);
-    if let Some(c) = t.interior().ball_contact(to_glam(&centre), radius) {
-        out.extend(placed(c, pt));
+    let inside = t.interior();
+    let centre = to_glam(&(pt.1.inverse() * (pb.0 - pt.0)));
+    if let (Some(c), Some(core)) = (inside.ball_contact(centre, radius), inside.nearest(centre)) {
+        let rho = (centre - core.point).length();
+        let (tangent, kappa) = (
+            pt.1 * from_glam(core.tangent),
+            pt.1 * from_glam(core.curvature),
+        );
+        out.extend(placed(c, pt, |n| {
+            NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
+        }));
     }
 }
 
@@ -436,7 +598,14 @@ fn torus_ball(
     };
     let p = pa.1.inverse() * (pb.0 - pa.0);
     if let Some(c) = flank.ball_contact(to_glam(&p), ball_radius) {
-        out.extend(placed(c, pa));
+        // The core circle's tangent and curvature at the nearest point.
+        let r = p - centre;
+        let dir = (r - r.dot(axis) * axis).normalize();
+        let rho = c.depth + flank.tube_radius - ball_radius;
+        let (tangent, kappa) = (pa.1 * axis.cross(&dir), pa.1 * (-dir / core_radius));
+        out.extend(placed(c, pa, |n| {
+            NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
+        }));
     }
 }
 
@@ -456,7 +625,11 @@ fn slot_ball(
         half_width,
     };
     let p = pa.1.inverse() * (pb.0 - pa.0);
-    out.extend(placed(slot.ball_contact(to_glam(&p), ball_radius), pa));
+    out.extend(placed(
+        slot.ball_contact(to_glam(&p), ball_radius),
+        pa,
+        |_| NormalTurning::plane(*pb.0),
+    ));
 }
 
 /// Sphere (centre ob, world) inside a cavity (centre oa, world).
@@ -472,12 +645,15 @@ fn cavity_sphere(
     if let Some(c) = cavity.sphere_contact(to_glam(ob), sphere_radius)
         && c.depth > 0.0
     {
+        let normal = from_glam(c.normal);
+        let rho = (ob - oa).norm();
         out.push(ContactPoint {
             slot: c.feature,
             point: from_glam(c.point),
-            normal: from_glam(c.normal),
+            normal,
             depth: c.depth,
             weight: 1.0,
+            turning: NormalTurning::lumen(*ob, &normal, rho, &Vec3::zeros(), &Vec3::zeros()),
         });
     }
 }

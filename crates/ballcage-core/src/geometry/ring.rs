@@ -13,8 +13,8 @@
 //! and √g = ρ·cos t − h·sin t (docs/model.md §3): the
 //! closed form the tests check.
 
-use super::ContactPoint;
-use crate::math::{Quat, Vec3};
+use super::{CentreMotion, ContactPoint, NormalTurning, Slide};
+use crate::math::{Mat3, Quat, Vec3};
 
 /// The ring (on body a) and the cylinder (on body b) in their bodies' frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,12 +55,27 @@ impl RingCylinder {
             return;
         }
         let normal = to_axis / d;
+        // The ring point (on a) in the neck's field (b): the normal toward
+        // the axis turns as c moves across it, by −(I − n·nᵀ − â·âᵀ)/d.
+        let across = Mat3::identity() - normal * normal.transpose() - a * a.transpose();
+        // c is the ring point nearest the axis, (c − foot)·t̂ = 0: it slides
+        // along the ring (tangent t̂, curvature −(c − O)/ρ²).
+        let radial = (c - o) / self.ring_radius;
         out.push(ContactPoint {
             slot: 0,
             point: c - 0.5 * depth * normal,
             normal,
             depth,
             weight: 1.0,
+            turning: NormalTurning {
+                centre: c,
+                curvature: -across / d,
+                centre_on_b: false,
+                motion: CentreMotion::Slides(Slide {
+                    direction: e.cross(&radial),
+                    curvature: -radial / self.ring_radius,
+                }),
+            },
         });
     }
 }

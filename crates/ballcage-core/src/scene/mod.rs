@@ -49,7 +49,9 @@ pub enum IntegratorKind {
     /// force evaluation and one sparse LU solve per step.
     LinearlyImplicitEuler,
     /// Two-stage singly diagonally implicit Runge–Kutta (Alexander's SDIRK2,
-    /// γ = 1 − 1/√2): second order, L-stable and stiffly accurate; implicit
+    /// γ = 1 − 1/√2): second order (formally, for smooth problems; on contact
+    /// scenes the observed order can be lower and erratic, docs/accuracy.md),
+    /// L-stable and stiffly accurate; implicit
     /// in every force (elastic, damping, friction, joints), solved per stage
     /// by simplified Newton iterations on the velocity twists with the
     /// analytic Jacobian D + γh·K ([`NewtonSpec`]), its LU factorization
@@ -61,9 +63,9 @@ pub enum IntegratorKind {
     /// estimate. The implicit stages are solved as SDIRK2's (same Newton
     /// iterations, Jacobian and linear solver); rotations by
     /// Runge–Kutta–Munthe-Kaas. Fixed steps of `simulation.dt`, or adaptive
-    /// steps when `simulation.rtol` is set. Opt-in: its Newton matrix still
-    /// lacks the geometric Jacobian terms (issue 26 item 2), and it is not
-    /// among [`IntegratorKind::ALL`] (the studies' integrators).
+    /// steps when `simulation.rtol` is set. Opt-in: no default tolerance
+    /// has been established for the paper scene yet (issue 26), and it is
+    /// not among [`IntegratorKind::ALL`] (the studies' integrators).
     Esdirk32,
 }
 
@@ -99,7 +101,10 @@ impl IntegratorKind {
         )
     }
 
-    /// Order of accuracy of the global error in the step.
+    /// Formal order of accuracy of the global error in the step, for smooth
+    /// problems. Penalty contacts that begin and release during a run are not
+    /// smooth: there the observed order can be lower and erratic
+    /// (docs/accuracy.md, "What a run's accuracy is today").
     pub fn order(self) -> u32 {
         match self {
             Self::SymplecticEuler | Self::LinearlyImplicitEuler => 1,

@@ -1,0 +1,306 @@
+"""A run's measured error: the same scene ten times tighter, and the difference of each headline quantity.
+
+``ballcage run --verify`` and ``simulate(..., verify=True)`` call `verify` on
+the finished run (`ballcage.run.VERIFIER`). It reruns the scene at the
+setting `tighter` gives (``dt/4`` for SDIRK2, ``rtol/10`` for adaptive steps),
+takes the headline quantities of both runs (`headline`: the drill pipe's
+comparison quantities, `ballcage.measures.DRILL_PIPE`, as
+`ballcage.studies.sweep_quantities.for_scene` picks them; a generic scene's
+summary statistics) and tabulates their differences (`compare`) as a
+`ballcage.run.Verification`, written as ``verify.parquet``. `verdict` is the
+one line ``ballcage run --verify`` ends with.
+
+The relative difference is ``|a − b| / max(|b|, floor)``, a the run's value
+and b the verification run's: `floor` is the quantity's natural scale near
+zero, the accuracy study's floor of its unit (`ballcage.studies.FLOORS`: 1 N,
+0.1°, 1 mm, …). A unit without a floor (an efficiency) has none: the relative
+difference is then null when b is zero and a is not. A quantity without a
+unit (a part number, as ``most_deformed_joint``) has no relative difference;
+its note says whether the runs agree.
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import math
+import sys
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from ballcage import _native
+from ballcage.run import Run, Verification, simulate
+
+if TYPE_CHECKING:
+    import pyarrow as pa
+
+__all__ = [
+    "Tighter",
+    "VerificationError",
+    "compare",
+    "floor",
+    "headline",
+    "tighter",
+    "verdict",
+    "verify",
+]
+
+#: A run's error bound falls by this factor in the verification run.
+TIGHTER = 10
+#: The rule of ``verify.parquet``'s relative difference (also in its schema metadata, ``ballcage.verify.relative``).
+RELATIVE = (
+    "rel_difference = |run_value - verify_value| / max(|verify_value|, floor), floor the quantity's natural scale "
+    "near zero: the accuracy study's floor of its unit (ballcage.studies.FLOORS: 1 N, 0.1 deg, 1 mm, 1 mm/s, "
+    "1e-3 rad/s, 1 mJ); a unit without a floor has none, and rel_difference is null when verify_value is zero and "
+    "run_value is not; a quantity without a unit (a part number) has none; 0 where the values are equal"
+)
+#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' integrators, not the
+#: opt-in ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
+_OPT_IN_ORDERS = {"esdirk32": 3}
+#: The columns of ``verify.parquet``: name -> (Arrow type name, unit, description).
+COLUMNS: dict[str, tuple[str, str, str]] = {
+    "quantity": ("string", "", "headline quantity: a drill pipe's comparison quantity (as in a sweep's summary.parquet) "
+                 "or a generic scene's summary statistic, <column of the summary table>[<contact pair>]"),
+    "unit": ("string", "", "unit of run_value, verify_value, abs_difference and floor"),
+    "run_value": ("float64", "", "the run's value (in unit); null where not computed or not finite"),
+    "verify_value": ("float64", "", "the verification run's value (in unit): the same scene ten times tighter"),
+    "abs_difference": ("float64", "", "|run_value - verify_value| (in unit): the run's measured error"),
+    "rel_difference": ("float64", "1", "abs_difference / max(|verify_value|, floor); null: see note"),
+    "floor": ("float64", "", "the quantity's natural scale near zero (in unit): the accuracy study's floor of its unit; "
+              "null for a unit without one"),
+    "note": ("string", "", "why rel_difference is null, or how the runs compare where it cannot say"),
+}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Tighter:
+    """The verification run's setting: its `label` (``"dt/4"``, ``"rtol/10"``) and the `overrides` that make it."""
+
+    label: str
+    overrides: tuple[str, ...]
+
+
+class VerificationError(_native.SimulationError):
+    """The verification run failed (it diverged, or its scene was refused, e.g. by ``simulation.max_steps``).
+
+    ``e.run`` is the run that was being verified, complete but without a
+    verification; ``e.check`` what the verification run recorded up to its
+    failure (``None`` when it did not start).
+    """
+
+    run: Run
+    check: Run | None
+
+
+def tighter(scene: _native.Scene) -> Tighter:
+    """The verification run's setting: the scene's error bound ten times tighter.
+
+    - Adaptive steps (``simulation.rtol`` set; ESDIRK3(2)): ``rtol/10``, and
+      ``atol/10`` when the scene sets ``simulation.atol`` (unset, it follows
+      rtol). ``dt``, the largest step, is kept.
+    - Fixed steps: ``dt/d`` with d = ceil(10^(1/p)), p the integrator's order
+      (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
+      dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
+      by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
+      step, so the frames are the same.
+
+    Every other field (the Newton tolerance, ``max_steps``) is kept: a
+    ``max_steps`` the d times more steps exceed makes the verification fail.
+    """
+    simulation = scene.value("simulation")
+    rtol = simulation.get("rtol")
+    if rtol is not None:
+        overrides = [f"simulation.rtol={rtol / TIGHTER!r}"]
+        if simulation.get("atol") is not None:
+            overrides.append(f"simulation.atol={simulation['atol'] / TIGHTER!r}")
+        return Tighter(f"rtol/{TIGHTER}", tuple(overrides))
+    name = simulation["integrator"]
+    order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
+    d = math.ceil(TIGHTER ** (1.0 / order))
+    return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
+
+
+def verify(run: Run, *, progress: bool | None = None) -> Verification:
+    """Runs `run`'s scene at the `tighter` setting and compares their `headline` quantities.
+
+    `run` must be complete. `progress` is as for `simulate`; unless it is
+    ``False``, a line on stderr announces the verification run. Raises
+    `VerificationError` when the verification run diverges or its scene is
+    refused; an interrupt (`KeyboardInterrupt`) during it is re-raised
+    carrying `run`, complete, as ``e.run``.
+    """
+    if not run.complete:
+        raise _native.InputError(f"cannot verify an incomplete run ({run.error or 'ballcage.complete = false'})")
+    setting = tighter(run.scene)
+    if progress is not False:  # the verification run's bar starts again from 0 %
+        print(f"ballcage: verifying: the run again at {setting.label} ({', '.join(setting.overrides)})", file=sys.stderr)
+    try:
+        check = simulate(run.scene, overrides=setting.overrides, progress=progress)
+        table = compare(headline(run), headline(check))
+    except (_native.SimulationError, _native.SceneError) as e:
+        error = VerificationError(f"the verification run at {setting.label} failed: {e}")
+        error.run, error.check = run, getattr(e, "run", None)
+        raise error from e
+    except KeyboardInterrupt as e:
+        e.run = run  # type: ignore[attr-defined]  # the complete run, not the verification's part
+        raise
+    rel = [(r, q) for r, q in zip(table["rel_difference"].to_pylist(), table["quantity"].to_pylist()) if r is not None]
+    largest, quantity = max(rel, key=lambda rq: rq[0]) if rel else (None, None)
+    run_time, check_time = (_float(r.metadata.get("ballcage.wall_time_s")) for r in (run, check))
+    ratio = check_time / run_time if check_time is not None and run_time else None
+    meta = {
+        "ballcage.table": "verify",
+        "ballcage.row": "one row per headline quantity",
+        "ballcage.version": _native.__version__,
+        "ballcage.verify.setting": setting.label,
+        "ballcage.verify.overrides": json.dumps(setting.overrides),
+        "ballcage.verify.rule": inspect.cleandoc(tighter.__doc__ or ""),
+        "ballcage.verify.relative": RELATIVE,
+        "ballcage.verify.run_wall_time_s": run.metadata.get("ballcage.wall_time_s", ""),
+        "ballcage.verify.check_wall_time_s": check.metadata.get("ballcage.wall_time_s", ""),
+        "ballcage.verify.time_ratio": "" if ratio is None else repr(ratio),
+        "ballcage.verify.run_dt_s": run.metadata.get("ballcage.dt_s", ""),
+        "ballcage.verify.check_dt_s": check.metadata.get("ballcage.dt_s", ""),
+        "ballcage.verify.largest_relative": "" if largest is None else repr(largest),
+        "ballcage.verify.largest_quantity": quantity or "",
+    }
+    return Verification(table.replace_schema_metadata(meta), setting.label, setting.overrides, largest, quantity, ratio)
+
+
+def headline(run: Run) -> dict[str, tuple[str, float | None]]:
+    """The run's headline quantities, name -> (unit, value; ``None`` where not computed).
+
+    The quantities of the scene kind's sweep plug-in (`for_scene`: the drill
+    pipe's `DRILL_PIPE`); when it has none (`GENERIC`), the summary statistics
+    of each contact pair, ``<statistic>[<pair>]`` for every column of the
+    ``summary`` table in N (empty without that table).
+    """
+    from ballcage.studies.sweep_quantities import for_scene  # deferred: numpy, the measures
+
+    plugin = for_scene(run.scene)
+    values = plugin(run)
+    if not values:
+        return _summary_statistics(run)
+    columns = plugin.columns(values)
+    return {name: (columns[name][0], value) for name, value in values.items()}
+
+
+def _summary_statistics(run: Run) -> dict[str, tuple[str, float | None]]:
+    """``<statistic>[<pair>]`` -> (unit, value) for each contact pair and each force column of ``summary``."""
+    summary = run.tables.get("summary")
+    if summary is None:
+        return {}
+    units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in summary.schema}
+    stats = [name for name, unit in units.items() if unit == "N"]
+    out: dict[str, tuple[str, float | None]] = {}
+    for row in summary.select(["pair", *stats]).to_pylist():
+        for stat in stats:
+            out[f"{stat}[{row['pair']}]"] = ("N", row[stat])
+    return out
+
+
+def floor(unit: str) -> float | None:
+    """The natural scale near zero of a quantity in `unit`: the accuracy study's floor of that unit, else ``None``."""
+    from ballcage.studies.scalars import FLOORS  # deferred: numpy
+
+    floors = {u: value for value, u in FLOORS.values()}
+    if unit == "mm" and "m" in floors:
+        return 1e3 * floors["m"]
+    return floors.get(unit)
+
+
+def compare(
+    values: Mapping[str, tuple[str, float | None]], reference: Mapping[str, tuple[str, float | None]]
+) -> pa.Table:
+    """The ``verify.parquet`` table of the run's headline `values` against the verification run's `reference`.
+
+    One row per quantity of either (the reference's order first); a value that
+    is ``None`` or not finite is null. Columns and the relative rule: `COLUMNS`
+    and the module's docstring.
+    """
+    import pyarrow as pa
+
+    rows = [_row(name, values.get(name), reference.get(name)) for name in {**reference, **values}]
+    fields = [
+        pa.field(name, getattr(pa, kind)(), metadata={"unit": unit, "description": description})
+        for name, (kind, unit, description) in COLUMNS.items()
+    ]
+    return pa.Table.from_pylist(rows, schema=pa.schema(fields))
+
+
+def _row(
+    name: str, value: tuple[str, float | None] | None, reference: tuple[str, float | None] | None
+) -> dict[str, Any]:
+    """One row of `compare`."""
+    unit = (reference or value or ("", None))[0]
+    a, b = _finite(value), _finite(reference)
+    low = floor(unit) if unit else None
+    row: dict[str, Any] = dict.fromkeys(COLUMNS) | {"quantity": name, "unit": unit, "run_value": a, "verify_value": b}
+    row["floor"] = low
+    if a is None or b is None:
+        missing = [label for label, v in (("the run", a), ("the verification run", b)) if v is None]
+        row["note"] = f"not computed (or not finite) in {' and '.join(missing)}"
+        return row
+    row["abs_difference"] = abs(a - b)
+    if not unit:
+        row["note"] = "a part number, not a magnitude: " + ("the runs agree" if a == b else "the runs differ")
+    elif a == b:
+        row["rel_difference"] = 0.0
+    elif max(abs(b), low or 0.0) > 0.0:
+        row["rel_difference"] = abs(a - b) / max(abs(b), low or 0.0)
+    else:
+        row["note"] = f"zero in the verification run and no floor for unit {unit!r}: no relative difference"
+    return row
+
+
+def verdict(verification: Verification) -> str:
+    """The last line of ``ballcage run --verify``.
+
+    ``error ≤ 0.31 % on <quantity> (verified at dt/4: 3.9× the run's time)``: the largest relative
+    difference, its quantity, the setting and the verification run's wall time over the run's.
+    """
+    ratio = verification.time_ratio
+    cost = f"verified at {verification.setting}: " + (
+        f"{_two_digits(ratio)}× the run's time" if ratio is not None else "its time not measured"
+    )
+    if verification.largest is None:
+        return f"error not measured: no headline quantity has a relative difference, see verify.parquet ({cost})"
+    return f"error ≤ {_two_digits(100.0 * verification.largest)} % on {verification.quantity} ({cost})"
+
+
+def disagreements(verification: Verification) -> list[str]:
+    """One line per quantity the runs disagree on without a relative difference (a part number, a missing value)."""
+    out = []
+    for row in verification.table.to_pylist():
+        a, b = row["run_value"], row["verify_value"]
+        if row["rel_difference"] is None and a != b:
+            out.append(f"{row['quantity']}: {_value(a)} in the run, {_value(b)} verified ({row['note']})")
+    return out
+
+
+def _two_digits(x: float) -> str:
+    """`x` to two significant digits without an exponent from 0.001 to 10⁴: 0.31, 3.9, 12, 150."""
+    if x == 0.0 or not math.isfinite(x):
+        return f"{x:g}"
+    if not 1e-3 <= abs(x) < 1e4:
+        return f"{x:.2g}"
+    return f"{x:.{max(0, 1 - math.floor(math.log10(abs(x))))}f}"
+
+
+def _value(x: float | None) -> str:
+    return "none" if x is None else f"{x:.6g}"
+
+
+def _finite(value: tuple[str, float | None] | None) -> float | None:
+    if value is None or value[1] is None:
+        return None
+    x = float(value[1])
+    return x if math.isfinite(x) else None
+
+
+def _float(text: str | None) -> float | None:
+    try:
+        return float(text) if text else None
+    except ValueError:
+        return None

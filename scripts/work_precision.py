@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Work–precision of the paper scene: fixed-step SDIRK2 and adaptive ESDIRK3(2).
+
+    python3 scripts/work_precision.py [--duration S] [--out FILE.json]
+
+Runs the embedded paper scene (ball keys, level-set link–tube law) with
+each setting below, and compares every drill-pipe comparison quantity
+(`ballcage.measures.DRILL_PIPE`, the quantities of `ballcage run --verify`)
+with two references by different methods: SDIRK2 at 25 µs and ESDIRK3(2)
+at rtol = 1e-5. Their own difference is the reference's error. Prints a
+markdown table (docs/accuracy.md): wall time, real-time factor, Newton
+iterations per stage, rejected steps, halvings, fallback steps, and the
+largest relative difference from the SDIRK2 reference with its quantity.
+Takes about 8 minutes on this project's machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import ballcage
+from ballcage.verify import headline
+
+ESDIRK = ['simulation.integrator="esdirk32"', "simulation.dt=1e-3"]
+CASES: dict[str, list[str]] = {
+    "SDIRK2 25 µs (reference)": ["simulation.dt=2.5e-5"],
+    "ESDIRK3(2) rtol 1e-5 (reference)": [*ESDIRK, "simulation.rtol=1e-5"],
+    "SDIRK2 200 µs": ["simulation.dt=2e-4"],
+    "SDIRK2 100 µs (default)": [],
+    "SDIRK2 50 µs": ["simulation.dt=5e-5"],
+    "ESDIRK3(2) rtol 1e-3": [*ESDIRK, "simulation.rtol=1e-3"],
+    "ESDIRK3(2) rtol 3e-4": [*ESDIRK, "simulation.rtol=3e-4"],
+    "ESDIRK3(2) rtol 1e-4": [*ESDIRK, "simulation.rtol=1e-4"],
+}
+
+
+def measure(overrides: list[str], duration: float) -> dict:
+    """One run: its wall time [s], solver metadata and headline quantities."""
+    start = time.perf_counter()
+    run = ballcage.simulate(
+        {"kind": "drill-pipe"}, overrides=[*overrides, f"simulation.duration={duration}"], progress=False
+    )
+    meta = run.metadata
+    keys = ("newton_iterations", "real_time_factor", "steps", "accepted_steps", "rejected_steps")
+    keys += ("step_halvings", "fallback_steps", "smallest_step_s")
+    return {
+        "wall_s": time.perf_counter() - start,
+        "meta": {k: meta.get(f"ballcage.{k}") for k in keys},
+        "quantities": {name: value for name, (_, value) in headline(run).items()},
+    }
+
+
+def largest_difference(run: dict, reference: dict) -> tuple[float, str]:
+    """The largest |a − b|/|b| over the quantities both have (b ≠ 0), and its quantity."""
+    worst = (0.0, "")
+    for name, b in reference["quantities"].items():
+        a = run["quantities"].get(name)
+        if a is None or b is None or b == 0:
+            continue
+        worst = max(worst, (abs(a - b) / abs(b), name))
+    return worst
+
+
+def per_stage(meta: dict) -> float:
+    """Newton iterations per implicit stage: SDIRK2 has 2 per step, ESDIRK3(2) 3 per attempted step."""
+    iterations = float(meta["newton_iterations"] or 0)
+    if meta["accepted_steps"] is not None:
+        return iterations / (3 * (int(meta["accepted_steps"]) + int(meta["rejected_steps"])))
+    return iterations / (2 * (int(meta["steps"]) + int(meta["step_halvings"])))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--duration", type=float, default=1.8, help="simulated time [s] (default 1.8)")
+    parser.add_argument("--out", default="work_precision.json", help="where the raw results go")
+    args = parser.parse_args()
+    results = {}
+    for name, overrides in CASES.items():
+        results[name] = measure(overrides, args.duration)
+        print(f"{name}: {results[name]['wall_s']:.1f} s", flush=True)
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    reference = results["SDIRK2 25 µs (reference)"]
+    print("\n| setting | wall [s] | real-time factor | Newton its/stage | rejected | halvings | fallbacks | largest difference from SDIRK2 25 µs |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name, r in results.items():
+        m = r["meta"]
+        diff, quantity = largest_difference(r, reference)
+        shown = "—" if r is reference else f"{100 * diff:.3g} % ({quantity})"
+        print(
+            f"| {name} | {r['wall_s']:.1f} | {m['real_time_factor']} | {per_stage(m):.2f} | "
+            f"{m['rejected_steps'] or '—'} | {m['step_halvings']} | {m['fallback_steps']} | {shown} |"
+        )
+
+
+if __name__ == "__main__":
+    main()

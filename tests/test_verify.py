@@ -1,0 +1,260 @@
+"""`simulate(..., verify=True)` and ``ballcage run --verify``: a run's error measured against a run ten times tighter.
+
+The scene is examples/scenes/two_balls.toml (two 1 kg balls meet head-on at
+t = 0.05 s of 0.1 s; Hunt–Crossley), run with SDIRK2 at coarse steps so that
+the impact's summary statistics (peak, mean and RMS normal force of the pair)
+carry a step error of a few percent. The checks are on the physics: the
+difference falls with the run's step, the tighter run is closer to the truth
+than the run it checks, and the setting follows the order rule.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import ballcage
+from ballcage import cli
+from ballcage.run import Verification
+from ballcage.verify import VerificationError, compare, disagreements, tighter, verdict
+
+TWO_BALLS = Path(__file__).resolve().parent.parent / "examples" / "scenes" / "two_balls.toml"
+SDIRK2 = 'simulation.integrator="sdirk2"'
+COARSE, FINER = 1e-4, 5e-5  # s: the run's step; the contact lasts about 0.3 ms
+VERDICT = re.compile(r"^error ≤ ([0-9.e+-]+) % on (\S+) \(verified at (\S+): ([0-9.]+)× the run's time\)$")
+COLUMNS = {
+    "quantity": pa.string(),
+    "unit": pa.string(),
+    "run_value": pa.float64(),
+    "verify_value": pa.float64(),
+    "abs_difference": pa.float64(),
+    "rel_difference": pa.float64(),
+    "floor": pa.float64(),
+    "note": pa.string(),
+}
+
+
+def _verified(dt: float, *more: str) -> ballcage.Run:
+    return ballcage.simulate(TWO_BALLS, overrides=[SDIRK2, f"simulation.dt={dt!r}", *more], progress=False, verify=True)
+
+
+@pytest.fixture(scope="module")
+def runs() -> dict[float, ballcage.Run]:
+    return {dt: _verified(dt) for dt in (COARSE, FINER)}
+
+
+def _rows(run: ballcage.Run) -> dict[str, dict]:
+    assert run.verification is not None
+    return {row["quantity"]: row for row in run.verification.table.to_pylist()}
+
+
+@pytest.mark.parametrize(
+    ("integrator", "d"),
+    [("symplectic-euler", 10), ("linearly-implicit-euler", 10), ("sdirk2", 4), ("esdirk32", 3), ("rk4", 2)],
+)
+def test_a_fixed_step_is_divided_by_the_ceiling_of_ten_to_one_over_the_order(integrator, d):
+    scene = ballcage.load_scene(TWO_BALLS, [f'simulation.integrator="{integrator}"'])
+    setting = tighter(scene)
+    assert setting.label == f"dt/{d}"
+    check = ballcage.load_scene(scene, setting.overrides)  # valid: the frames stay on whole steps
+    assert check.dt == pytest.approx(scene.dt / d, rel=1e-12)
+    assert check.output_interval == scene.output_interval
+    assert check.duration == scene.duration
+    # the bound C·dt^p falls at least tenfold, and the next smaller divisor would not be enough
+    order = {"symplectic-euler": 1, "linearly-implicit-euler": 1, "sdirk2": 2, "esdirk32": 3, "rk4": 4}[integrator]
+    assert d == math.ceil(10 ** (1 / order))
+    assert d**order >= 10 > (d - 1) ** order
+
+
+def test_adaptive_steps_tighten_rtol_and_a_set_atol_tenfold_and_keep_dt():
+    adaptive = ['simulation.integrator="esdirk32"', "simulation.rtol=1e-3"]
+    scene = ballcage.load_scene(TWO_BALLS, adaptive)
+    assert tighter(scene).label == "rtol/10"
+    check = ballcage.load_scene(scene, tighter(scene).overrides)
+    assert check.value("simulation.rtol") == pytest.approx(1e-4)
+    assert "atol" not in check.value("simulation")  # unset, it follows rtol
+    assert check.dt == scene.dt
+    with_atol = ballcage.load_scene(TWO_BALLS, [*adaptive, "simulation.atol=1e-6"])
+    check = ballcage.load_scene(with_atol, tighter(with_atol).overrides)
+    assert check.value("simulation.atol") == pytest.approx(1e-7)
+
+
+def test_an_adaptive_run_is_verified_at_rtol_over_ten_and_its_error_falls_with_rtol():
+    # dt = 100 us, the largest step, so that rtol and not dt sets the steps through the impact
+    largest = {}
+    for rtol in (1e-3, 1e-4):
+        run = ballcage.simulate(
+            TWO_BALLS,
+            overrides=['simulation.integrator="esdirk32"', "simulation.dt=1e-4", f"simulation.rtol={rtol!r}"],
+            progress=False,
+            verify=True,
+        )
+        assert run.verification is not None and run.verification.setting == "rtol/10"
+        assert run.verification.overrides == (f"simulation.rtol={rtol / 10!r}",)
+        largest[rtol] = run.verification.largest
+    assert 0 < largest[1e-4] < largest[1e-3] / 3
+
+
+def test_the_impact_happens_in_the_window_and_its_forces_move_with_the_step(runs):
+    coarse, finer = _rows(runs[COARSE]), _rows(runs[FINER])
+    assert coarse["normal_peak[impact]"]["run_value"] > 1e3  # N: the balls meet within the 0.1 s
+    for name in ("normal_peak[impact]", "normal_mean[impact]", "normal_rms[impact]"):
+        assert coarse[name]["run_value"] != finer[name]["run_value"]
+    # no friction in the scene: both runs agree exactly, relative 0 (not a division by zero)
+    assert coarse["tangential_peak[impact]"]["run_value"] == 0.0
+    assert coarse["tangential_peak[impact]"]["rel_difference"] == 0.0
+
+
+def test_the_measured_error_is_nonzero_and_falls_with_the_runs_step(runs):
+    coarse, finer = runs[COARSE].verification, runs[FINER].verification
+    assert coarse is not None and finer is not None
+    assert coarse.setting == finer.setting == "dt/4"
+    assert coarse.largest is not None and finer.largest is not None
+    assert 1e-4 < coarse.largest < 0.2
+    assert finer.largest < coarse.largest / 2  # second order: about 4x less at half the step
+    for name in ("normal_peak[impact]", "normal_mean[impact]", "normal_rms[impact]"):
+        assert _rows(runs[FINER])[name]["abs_difference"] < _rows(runs[COARSE])[name]["abs_difference"]
+
+
+def test_the_tighter_run_is_closer_to_the_truth_than_the_run_it_checks(runs):
+    # the two verification runs (25 and 12.5 us) agree better than the two runs (100 and 50 us)
+    coarse, finer = _rows(runs[COARSE]), _rows(runs[FINER])
+    for name in ("normal_peak[impact]", "normal_mean[impact]", "normal_rms[impact]"):
+        runs_apart = abs(coarse[name]["run_value"] - finer[name]["run_value"])
+        checks_apart = abs(coarse[name]["verify_value"] - finer[name]["verify_value"])
+        assert checks_apart < runs_apart / 4
+
+
+def test_verify_parquet_holds_the_table_the_setting_and_both_wall_times(runs, tmp_path):
+    run = runs[COARSE]
+    assert run.verification is not None
+    assert "summary" in run.tables  # recorded for the verification: the scene's record.tables lack it
+    written = run.write(tmp_path)
+    assert written["verify"] == tmp_path / "verify.parquet"
+    table = pq.read_table(tmp_path / "verify.parquet")
+    assert {f.name: f.type for f in table.schema} == COLUMNS
+    assert table.num_rows == 6  # six force statistics of the one pair
+    meta = {k.decode(): v.decode() for k, v in table.schema.metadata.items()}
+    assert meta["ballcage.verify.setting"] == "dt/4"
+    assert meta["ballcage.verify.overrides"] == '["simulation.dt=2.5e-05"]'
+    assert float(meta["ballcage.verify.check_dt_s"]) == pytest.approx(COARSE / 4)
+    ratio = float(meta["ballcage.verify.check_wall_time_s"]) / float(meta["ballcage.verify.run_wall_time_s"])
+    assert ratio == pytest.approx(run.verification.time_ratio)
+    assert run.verification.time_ratio > 0  # a wall-time ratio of millisecond runs: not compared with 4
+    assert float(meta["ballcage.verify.largest_relative"]) == run.verification.largest
+    assert meta["ballcage.verify.largest_quantity"] == run.verification.quantity
+    rel = [r for r in table.column("rel_difference").to_pylist() if r is not None]
+    assert max(rel) == run.verification.largest
+
+
+def test_cli_run_verify_ends_with_the_largest_error(tmp_path, capsys):
+    out = tmp_path / "out"
+    argv = ["run", str(TWO_BALLS), "--verify", "--out", str(out), "--set", SDIRK2, "--set", f"simulation.dt={COARSE}"]
+    code = cli.main(argv)
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    last = captured.out.strip().splitlines()[-1]
+    match = VERDICT.match(last)
+    assert match, last
+    table = pq.read_table(out / "verify.parquet").to_pylist()
+    best = max((r for r in table if r["rel_difference"] is not None), key=lambda r: r["rel_difference"])
+    assert match.group(2) == best["quantity"]
+    assert float(match.group(1)) == pytest.approx(100 * best["rel_difference"], rel=0.05)
+    assert match.group(3) == "dt/4"
+    assert float(match.group(4)) > 0
+    assert f"wrote {out / 'verify.parquet'}  (6 rows x 8 columns" in captured.out
+
+
+def test_a_failed_verification_run_exits_1_and_keeps_the_runs_tables(tmp_path, capsys):
+    # 1000 steps fit simulation.max_steps = 1500, the verification run's 4000 do not
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "verify.parquet").write_bytes(b"an earlier run's")
+    argv = ["run", str(TWO_BALLS), "--verify", "--overwrite", "--out", str(out), "--set", SDIRK2]
+    code = cli.main([*argv, "--set", f"simulation.dt={COARSE}", "--set", "simulation.max_steps=1500"])
+    err = capsys.readouterr().err
+    assert code == 1
+    first, last = err.strip().splitlines()
+    assert first == "ballcage: verifying: the run again at dt/4 (simulation.dt=2.5e-05)"
+    assert last.startswith("ballcage: error: the verification run at dt/4 failed: ")
+    assert "simulation.max_steps" in last and "verify.parquet was not written" in last
+    bodies = pq.read_table(out / "bodies.parquet")
+    assert bodies.schema.metadata[b"ballcage.complete"] == b"true"
+    assert not (out / "verify.parquet").exists()  # the earlier run's is gone with the rest of that run
+    with pytest.raises(VerificationError) as info:
+        _verified(COARSE, "simulation.max_steps=1500")
+    assert isinstance(info.value, ballcage.SimulationError)
+    assert info.value.run.complete and info.value.run.verification is None
+    assert info.value.check is None  # refused before it started
+
+
+def test_an_interrupt_during_the_verification_keeps_the_runs_tables(tmp_path, capsys, monkeypatch):
+    import ballcage.verify
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(ballcage.verify, "simulate", interrupted)
+    out = tmp_path / "out"
+    code = cli.main(["run", str(TWO_BALLS), "--verify", "--quiet", "--out", str(out), "--set", SDIRK2])
+    err = capsys.readouterr().err
+    assert code == 130
+    assert "interrupted during the verification run; the run's own tables" in err
+    assert pq.read_table(out / "bodies.parquet").schema.metadata[b"ballcage.complete"] == b"true"
+
+
+def test_a_scene_without_contact_pairs_has_no_error_to_measure(tmp_path, capsys):
+    # a ball in free fall: no pair, so an empty summary table and no headline quantity
+    out = tmp_path / "out"
+    scene = tmp_path / "fall.toml"
+    scene.write_text(
+        'name = "fall"\n[simulation]\nduration = 0.1\ndt = 1e-3\noutput_interval = 1e-2\n'
+        "[world]\ngravity = [0.0, 0.0, -9.81]\n"
+        '[[bodies]]\nname = "ball"\nshape = { type = "ball", radius = 0.05 }\nmass = 1.0\n'
+    )
+    assert cli.main(["run", str(scene), "--verify", "--out", str(out)]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("error not measured: no headline quantity has a relative difference")
+    assert re.search(r"\(verified at dt/2: [0-9.]+× the run's time\)$", last)  # rk4, the generic default: dt/2
+    assert pq.read_table(out / "verify.parquet").num_rows == 0
+
+
+def test_non_finite_missing_zero_and_part_number_values_get_a_note_not_a_relative_difference():
+    values = {
+        "force": ("N", 101.0),
+        "nan": ("N", math.nan),
+        "gone": ("N", None),
+        "efficiency": ("1", 0.5),
+        "joint": ("", 6.0),
+        "small": ("N", 1e-3),
+    }
+    reference = {
+        "force": ("N", 100.0),
+        "nan": ("N", 5.0),
+        "gone": ("N", 5.0),
+        "efficiency": ("1", 0.0),
+        "joint": ("", 7.0),
+        "small": ("N", 2e-3),
+    }
+    rows = {r["quantity"]: r for r in compare(values, reference).to_pylist()}
+    assert rows["force"]["rel_difference"] == pytest.approx(0.01)
+    assert rows["small"]["rel_difference"] == pytest.approx(1e-3)  # near zero: against the 1 N floor
+    assert rows["small"]["floor"] == 1.0
+    assert rows["nan"]["run_value"] is None and rows["nan"]["rel_difference"] is None
+    assert "not computed (or not finite) in the run" in rows["nan"]["note"]
+    assert rows["gone"]["rel_difference"] is None
+    assert rows["efficiency"]["rel_difference"] is None and "zero in the verification run" in rows["efficiency"]["note"]
+    assert rows["joint"]["abs_difference"] == 1.0 and rows["joint"]["rel_difference"] is None
+    assert "the runs differ" in rows["joint"]["note"]
+    v = Verification(compare(values, reference), "dt/4", (), 0.01, "force", 4.0)
+    assert verdict(v) == "error ≤ 1.0 % on force (verified at dt/4: 4.0× the run's time)"
+    flagged = disagreements(v)
+    assert [line.split(":")[0] for line in flagged] == ["nan", "gone", "efficiency", "joint"]
+    nothing = Verification(compare({}, {}), "rtol/10", (), None, None, None)
+    assert verdict(nothing).startswith("error not measured")
+    assert verdict(nothing).endswith("(verified at rtol/10: its time not measured)")
