@@ -128,7 +128,8 @@ def test_accuracy_schema_units_and_roles(spin_study):
     assert table.schema.field("error").metadata[b"unit"] == b"1"
 
     runs = {(r["integrator"], r["dt"], r["role"]) for r in table.to_pylist()}
-    assert runs == {("rk4", 5e-5, "reference"), ("rk4", 1e-4, "reference-check")} | {
+    interval = float(table.schema.metadata[b"ballcage.output_interval_s"])
+    assert runs == {("rk4", 5e-5, "reference"), ("rk4", 1e-4, "reference-check"), ("esdirk32", interval, "second-method")} | {
         (i, dt, "run") for i in ("symplectic-euler", "rk4") for dt in LADDER
     }
     quantities = set(table.column("quantity").to_pylist())
@@ -193,6 +194,22 @@ def test_reference_self_error_is_recorded_and_small(spin_study):
     assert float(table.schema.metadata[b"ballcage.reference_self_error_max"]) < 1e-8
 
 
+def test_a_second_method_confirms_the_reference(spin_study):
+    # ESDIRK3(2) at rtol 1e-5 against RK4 at 50 µs: two integrators of different families agree on every
+    # quantity far below the ladder's errors. Its rows carry its error against the reference.
+    table = spin_study
+    second = _rows(table, role="second-method")
+    assert second and not any(r["diverged"] for r in second)
+    worst = float(table.schema.metadata[b"ballcage.second_method_error_max"])
+    assert worst == max(r["error"] for r in second)
+    assert 0.0 < worst < 1e-4
+    # The ladder's best RK4 run resolves less than the second method's agreement allows:
+    # the confirmation is of the reference, not of a run.
+    largest_ladder_error = max(e for _, e in _errors(table, "symplectic-euler", "final_angular_velocity_spinner"))
+    assert worst < 1e-2 * largest_ladder_error
+    assert table.schema.metadata[b"ballcage.second_method"] == b"esdirk32 rtol 1e-05"
+
+
 def test_a_study_where_every_run_diverged_still_writes_its_files(tmp_path):
     table = studies.accuracy(
         slot(1e8, duration=0.02),
@@ -227,8 +244,9 @@ def test_diverged_runs_are_rows_not_errors():
 
 def test_contact_scene_with_every_integrator_and_the_default_reference(tmp_path):
     table = studies.accuracy(bounce())
-    names = set(table.column("integrator").to_pylist())
+    names = {r["integrator"] for r in _rows(table, role="run")}
     assert names == set(ballcage._native.INTEGRATORS)
+    assert {r["integrator"] for r in _rows(table, role="second-method")} == {"esdirk32"}
     assert "peak_normal_force_ground/ball" in set(table.column("quantity").to_pylist())
     meta = table.schema.metadata
     assert meta[b"ballcage.reference_integrator"] == b"sdirk2"
@@ -383,7 +401,7 @@ def test_cli_accuracy_writes_the_files_and_prints_a_line_per_run(tmp_path, capsy
         assert (out / name).is_file(), name
         assert name in captured.out
     progress = [line for line in captured.err.splitlines() if line.startswith("ballcage: accuracy ")]
-    assert len(progress) == 2 + 2 + 1  # reference, check, then the ladder runs
+    assert len(progress) == 3 + 2 + 1  # reference, check, second method, then the ladder runs
     table = pq.read_table(out / "work_precision.parquet")
     assert sorted({(r["integrator"], r["dt"]) for r in _rows(table, role="run")}) == [
         ("rk4", 4e-3), ("symplectic-euler", 2e-3), ("symplectic-euler", 4e-3)

@@ -144,3 +144,17 @@ def test_the_stubs_table_names_are_the_modules():
     assert isinstance(literal.slice, ast.Tuple)
     names = [ast.literal_eval(e) for e in literal.slice.elts]
     assert names == list(_native.TABLE_NAMES)
+
+
+def test_scene_show_lists_the_optional_tolerances_while_they_are_unset():
+    # rtol and atol have no default: unset, the steps are fixed. `scene show` says so in the
+    # [simulation] table, with unit and meaning, and stops saying it for the one that is set.
+    shown = ballcage.Scene.from_toml('kind = "drill-pipe"').to_toml(units=True)
+    simulation = shown.split("[simulation]")[1].split("[simulation.newton]")[0]
+    assert "# rtol: unset, relative tolerance of esdirk32's adaptive steps" in simulation
+    assert "# atol: unset" in simulation and "[m, rad, m/s, rad/s]" in simulation
+    adaptive = ballcage.Scene.from_toml('kind = "drill-pipe"', ['simulation.integrator="esdirk32"', "simulation.rtol=1e-4"])
+    shown = adaptive.to_toml(units=True)
+    assert "rtol = 0.0001  # -" in shown and "# rtol: unset" not in shown
+    assert "# atol: unset" in shown
+    assert tomllib.loads(shown)["simulation"]["rtol"] == 1e-4

@@ -35,7 +35,8 @@ def add(commands: Commands) -> None:
             "Run a scene with each integrator over a ladder of steps and compare named quantities (drill pipe: "
             "peak key-seat force, mean tube force per joint, final link bends, energy; generic scenes: peak force "
             "per pair, final body states, energy) with a reference: the same scene at a much smaller step with "
-            "the most accurate integrator, also run at twice that step to show it has converged. Writes "
+            "the most accurate integrator, also run at twice that step (its self-error) and checked by a second "
+            "method, ESDIRK3(2) with adaptive steps at rtol 1e-5 (the two agreeing). Writes "
             "work_precision.parquet, work_precision.png (error against wall time, log-log) and work_precision.md. "
             "Runs that diverge are recorded as diverged, not errors."
         ),

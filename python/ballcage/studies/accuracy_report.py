@@ -162,7 +162,10 @@ def accuracy_markdown(table: pa.Table, *, command: str | None = None) -> str:
             if ref
             else ""
         )
-        + ". Errors at or below it are not resolved."
+        + ". Errors at or below it are not resolved. A second method, "
+        f"{meta.get('ballcage.second_method', '?')} (adaptive steps up to the output interval), agrees with the "
+        f"reference within {fmt(float(meta.get('ballcage.second_method_error_max', 'nan')))} "
+        f"({meta.get('ballcage.second_method_error_max_quantity', '')})."
     )
     lines += [
         "",

@@ -24,7 +24,7 @@ ACCURACY_SCHEMA = pa.schema(
             nullable=False,
             metadata={
                 "unit": "",
-                "description": "run: a ladder run; reference: the reference at dt_ref; reference-check: the reference integrator at 2 dt_ref",
+                "description": "run: a ladder run; reference: the reference at dt_ref; reference-check: the reference integrator at 2 dt_ref; second-method: ESDIRK3(2) at rtol 1e-5, adaptive steps up to the output interval",
             },
         ),
         pa.field("quantity", pa.string(), nullable=False, metadata={"unit": "", "description": "quantity name"}),

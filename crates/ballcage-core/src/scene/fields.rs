@@ -31,6 +31,9 @@ pub type LawRule = fn(key: &str, law: &toml::Table) -> Option<FieldInfo>;
 pub enum Fields {
     /// A number, an array of numbers, text or a boolean.
     Leaf,
+    /// A number that may be left out, its absence meaning something (the
+    /// meaning says what): `scene show` lists it as a comment when unset.
+    Optional,
     /// A table with these fields.
     Table(&'static [FieldDoc]),
     /// An array of tables, each with these fields.
@@ -70,6 +73,17 @@ impl FieldDoc {
             unit: "",
             meaning,
             fields: Fields::Leaf,
+        }
+    }
+
+    /// A number in `unit` that may be left out; `meaning` says what its
+    /// absence means.
+    pub const fn optional(key: &'static str, unit: &'static str, meaning: &'static str) -> Self {
+        Self {
+            key,
+            unit,
+            meaning,
+            fields: Fields::Optional,
         }
     }
 
@@ -129,7 +143,7 @@ pub fn flatten(docs: &'static [FieldDoc]) -> Vec<(String, &'static FieldDoc)> {
         let (inner, sep) = match doc.fields {
             Fields::Table(inner) => (inner, "."),
             Fields::Tables(inner) => (inner, "[]."),
-            Fields::Leaf | Fields::Law(_) => continue,
+            Fields::Leaf | Fields::Optional | Fields::Law(_) => continue,
         };
         for (key, d) in flatten(inner) {
             out.push((format!("{}{sep}{key}", doc.key), d));
@@ -193,7 +207,9 @@ pub fn describe(
                         Some(rule(part, table).ok_or_else(undocumented)?),
                         Fields::Leaf,
                     ),
-                    Fields::Leaf | Fields::Tables(_) => return Err(undocumented()),
+                    Fields::Leaf | Fields::Optional | Fields::Tables(_) => {
+                        return Err(undocumented());
+                    }
                 };
             }
             _ => return Err(undocumented()),
@@ -205,14 +221,19 @@ pub fn describe(
 /// `text`, a document as `to_toml` writes it (table headers and
 /// `key = value` lines at the start of a line, arrays over several lines),
 /// with `  # unit` after each line that sets a number or an array of
-/// numbers; `root` is the parsed document and `docs` its fields. The text
-/// parses to the same values.
+/// numbers, and a comment line `# key: unset, meaning [unit]` at the end of
+/// each table for each of its optional fields (`Fields::Optional`) the
+/// document leaves out; `root` is the parsed document and `docs` its
+/// fields. The text parses to the same values.
 pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> String {
     let mut section = String::new();
     // Elements seen so far of each array of tables (`[[bodies]]`), by its dotted name.
     let mut seen: std::collections::HashMap<String, usize> = Default::default();
     let mut out = String::with_capacity(text.len() + text.len() / 4);
     for line in text.lines() {
+        if line.starts_with('[') {
+            unset_fields(&mut out, docs, root, &section);
+        }
         out.push_str(line);
         if let Some(header) = line.strip_prefix('[') {
             let name = header.trim_matches(|c| c == '[' || c == ']');
@@ -241,7 +262,39 @@ pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> St
         }
         out.push('\n');
     }
+    unset_fields(&mut out, docs, root, &section);
     out
+}
+
+/// Appends `# key: unset, meaning [unit]` for each optional field of the
+/// table at dotted `section` (indices of arrays of tables included) that
+/// `root` leaves out.
+fn unset_fields(out: &mut String, docs: &'static [FieldDoc], root: &toml::Value, section: &str) {
+    let mut list = docs;
+    for part in section.split('.').filter(|p| !p.is_empty() && p.parse::<usize>().is_err()) {
+        match list.iter().find(|d| d.key == part).map(|d| d.fields) {
+            Some(Fields::Table(inner) | Fields::Tables(inner)) => list = inner,
+            _ => return,
+        }
+    }
+    // Inside the table: before the blank line that ends it, if any.
+    let blank = out.ends_with("\n\n");
+    if blank {
+        out.pop();
+    }
+    for doc in list.iter().filter(|d| matches!(d.fields, Fields::Optional)) {
+        let key = if section.is_empty() {
+            doc.key.to_string()
+        } else {
+            format!("{section}.{}", doc.key)
+        };
+        if lookup(root, &key).is_err() {
+            out.push_str(&format!("# {}: unset, {} [{}]\n", doc.key, doc.meaning, doc.unit));
+        }
+    }
+    if blank {
+        out.push('\n');
+    }
 }
 
 /// The dotted header `name` of `root` with the index of the last element

@@ -353,10 +353,13 @@ impl SimulationSpec {
             "s",
             "interval between recorded frames, a whole multiple of dt",
         ),
-        FieldDoc::text("integrator", "the fixed-step integrator"),
+        FieldDoc::text(
+            "integrator",
+            "the integrator (esdirk32 takes adaptive steps when rtol is set)",
+        ),
         FieldDoc::table(
             "newton",
-            "Newton iterations of the sdirk2 integrator",
+            "Newton iterations of the implicit integrators",
             NewtonSpec::FIELDS,
         ),
         FieldDoc::table(
@@ -370,13 +373,13 @@ impl SimulationSpec {
             "threads that evaluate the contact pairs in parallel (0: one per core)",
         ),
         FieldDoc::number("max_steps", "-", "most integrator steps a run may take"),
-        FieldDoc::number(
+        FieldDoc::optional(
             "rtol",
             "-",
             "relative tolerance of esdirk32's adaptive steps (absent: fixed steps of dt, \
              the largest step when set)",
         ),
-        FieldDoc::number(
+        FieldDoc::optional(
             "atol",
             "m, rad, m/s, rad/s",
             "absolute tolerance of the adaptive steps, in the SI unit of each quantity \

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""The extremes of docs/performance.md on the full paper scene, each alone.
+
+    python3 scripts/extremes.py [--integrator sdirk2|esdirk32] [--rtol R] [--out FILE.json]
+
+Runs the embedded paper scene (ball keys, 1.8 s) with each extreme below, by
+default with the shipped integrator; `--integrator esdirk32 --rtol 1e-4`
+runs them with adaptive steps of up to 1 ms. Prints a markdown table:
+whether the run finished, its CPU time [s], Newton iterations per stage,
+rejected steps, step halvings and first-order fallback part steps.
+Takes 5–10 minutes on this project's machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+import ballcage
+
+EXTREMES: dict[str, list[str]] = {
+    "the paper's scene (reference)": [],
+    "600 rpm": ["drive.speed_rpm=600"],
+    "tightest radius the hinge allows (0.771 m)": ["borehole.curvature_radius=0.771"],
+    "contact stiffness 1e7 N/mm^2.2 (100×)": [
+        "materials.internal.normal.stiffness=1e7",
+        "materials.tube.normal.stiffness=1e7",
+    ],
+    "no contact damping": ["materials.internal.normal.damping=0", "materials.tube.normal.damping=0"],
+    "μs = 1": ["materials.internal.friction.mu_static=1.0", "materials.tube.friction.mu_static=1.0"],
+    "5 kN·m": ["load.resisting_moment=5000"],
+    "24 joints": ["pipe.joints=24"],
+}
+
+
+def one(overrides: list[str]) -> dict:
+    """Runs one case; its outcome, CPU time [s] and solver counts."""
+    start = time.process_time()
+    try:
+        run = ballcage.simulate({"kind": "drill-pipe"}, overrides=overrides, progress=False)
+        meta, finished = run.metadata, "yes"
+    except ballcage.SimulationError as e:
+        meta, finished = e.run.metadata, f"no: {e}"  # type: ignore[attr-defined]
+    keys = ("newton_iterations", "steps", "accepted_steps", "rejected_steps", "step_halvings", "fallback_steps")
+    return {"finished": finished, "cpu_s": time.process_time() - start, **{k: meta.get(f"ballcage.{k}") for k in keys}}
+
+
+def per_stage(r: dict) -> float:
+    """Newton iterations per implicit stage (SDIRK2: 2 per step; ESDIRK3(2): 3 per attempted step)."""
+    its = float(r["newton_iterations"] or 0)
+    if r["accepted_steps"] is not None:
+        return its / (3 * (int(r["accepted_steps"]) + int(r["rejected_steps"])))
+    return its / (2 * (int(r["steps"]) + int(r["step_halvings"])))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--integrator", default=None, help="simulation.integrator (default: the scene's)")
+    parser.add_argument("--rtol", type=float, default=None, help="simulation.rtol, adaptive steps up to 1 ms (esdirk32)")
+    parser.add_argument("--out", default="extremes.json", help="where the raw results go")
+    args = parser.parse_args()
+    base = [] if args.integrator is None else [f'simulation.integrator="{args.integrator}"']
+    if args.rtol is not None:
+        base += [f"simulation.rtol={args.rtol!r}", "simulation.dt=1e-3"]
+    results = {}
+    for name, overrides in EXTREMES.items():
+        results[name] = one([*base, *overrides])
+        print(f"{name}: {results[name]['finished']}, {results[name]['cpu_s']:.1f} s", flush=True)
+    with open(args.out, "w") as f:
+        json.dump(results, f, indent=1)
+    print("\n| case | finished | CPU [s] | Newton its/stage | rejected | halvings | fallbacks |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for name, r in results.items():
+        print(
+            f"| {name} | {r['finished']} | {r['cpu_s']:.1f} | {per_stage(r):.2f} | "
+            f"{r['rejected_steps'] or '—'} | {r['step_halvings']} | {r['fallback_steps']} |"
+        )
+
+
+if __name__ == "__main__":
+    main()
