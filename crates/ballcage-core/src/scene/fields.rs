@@ -271,7 +271,10 @@ pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> St
 /// `root` leaves out.
 fn unset_fields(out: &mut String, docs: &'static [FieldDoc], root: &toml::Value, section: &str) {
     let mut list = docs;
-    for part in section.split('.').filter(|p| !p.is_empty() && p.parse::<usize>().is_err()) {
+    for part in section
+        .split('.')
+        .filter(|p| !p.is_empty() && p.parse::<usize>().is_err())
+    {
         match list.iter().find(|d| d.key == part).map(|d| d.fields) {
             Some(Fields::Table(inner) | Fields::Tables(inner)) => list = inner,
             _ => return,
@@ -289,7 +292,10 @@ fn unset_fields(out: &mut String, docs: &'static [FieldDoc], root: &toml::Value,
             format!("{section}.{}", doc.key)
         };
         if lookup(root, &key).is_err() {
-            out.push_str(&format!("# {}: unset, {} [{}]\n", doc.key, doc.meaning, doc.unit));
+            out.push_str(&format!(
+                "# {}: unset, {} [{}]\n",
+                doc.key, doc.meaning, doc.unit
+            ));
         }
     }
     if blank {
