@@ -69,9 +69,11 @@ def scene_overrides(joints: int) -> list[str]:
 
 
 def ballcage_scene(joints: int, dt: float, duration: float) -> ballcage.Scene:
-    """The paper's drill pipe with ideal-CV hinges, `joints` links, step `dt`, recording only ``links``."""
+    """The paper's drill pipe with ideal-CV hinges, `joints` links, SDIRK2's fixed step `dt`, recording only ``links``."""
     overrides = [
         'pipe.hinge="ideal-cv"',
+        'simulation.integrator="sdirk2"',
+        "simulation.rtol=0",
         f"pipe.joints={joints}",
         f"simulation.dt={dt!r}",
         f"simulation.duration={duration!r}",

@@ -23,16 +23,17 @@ import time
 import ballcage
 from ballcage.verify import headline
 
-ESDIRK = ['simulation.integrator="esdirk32"', "simulation.dt=1e-3"]
+ESDIRK = ['simulation.integrator="esdirk32"']
+SDIRK2 = ['simulation.integrator="sdirk2"', "simulation.rtol=0"]
 CASES: dict[str, list[str]] = {
-    "SDIRK2 25 µs (reference)": ["simulation.dt=2.5e-5"],
+    "SDIRK2 25 µs (reference)": [*SDIRK2, "simulation.dt=2.5e-5"],
     "ESDIRK3(2) rtol 1e-5 (reference)": [*ESDIRK, "simulation.rtol=1e-5"],
-    "SDIRK2 200 µs": ["simulation.dt=2e-4"],
-    "SDIRK2 100 µs (default)": [],
-    "SDIRK2 50 µs": ["simulation.dt=5e-5"],
+    "SDIRK2 200 µs": [*SDIRK2, "simulation.dt=2e-4"],
+    "SDIRK2 100 µs": [*SDIRK2, "simulation.dt=1e-4"],
+    "SDIRK2 50 µs": [*SDIRK2, "simulation.dt=5e-5"],
     "ESDIRK3(2) rtol 1e-3": [*ESDIRK, "simulation.rtol=1e-3"],
     "ESDIRK3(2) rtol 3e-4": [*ESDIRK, "simulation.rtol=3e-4"],
-    "ESDIRK3(2) rtol 1e-4": [*ESDIRK, "simulation.rtol=1e-4"],
+    "ESDIRK3(2) rtol 1e-4 (default)": [],
 }
 
 

@@ -198,6 +198,8 @@ def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
         [
             "pipe.joints=2",
             "simulation.duration=0.01",
+            'simulation.integrator="sdirk2"',
+            "simulation.rtol=0",
             "simulation.dt=1e-3",
             "simulation.newton.max_iterations=1",
             "simulation.newton.fallback=false",
@@ -207,6 +209,17 @@ def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
         ballcage.simulate(scene)
     text = str(info.value)
     assert "retried in halves" in text and "is probably not the cause" in text, text
+    assert "simulation.newton.max_iterations" in text
+    assert _advised_step(text) is None, text
+    # The adaptive default shrinks its own step to 1/1024 of the largest before it gives up:
+    # the message says so, and does not advise a step either.
+    adaptive = default_scene(
+        ["pipe.joints=2", "simulation.duration=0.01", "simulation.newton.max_iterations=1", "simulation.newton.fallback=false"]
+    )
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(adaptive)
+    text = str(info.value)
+    assert "the adaptive steps went down to" in text and "is probably not the cause" in text, text
     assert "simulation.newton.max_iterations" in text
     assert _advised_step(text) is None, text
 

@@ -38,6 +38,12 @@ def _set(what: str, override: str, *expect: str) -> Entry:
     return Entry(what, ("run", "--out", "{out}", "--set", override), expect or (override.split("=")[0],))
 
 
+def _fixed(what: str, override: str, *expect: str) -> Entry:
+    """`ballcage run` of the paper scene at fixed steps of SDIRK2 (``simulation.rtol = 0``) with one ``--set``."""
+    args = ("run", "--out", "{out}", "--set", 'simulation.integrator="sdirk2"', "--set", "simulation.rtol=0")
+    return Entry(what, (*args, "--set", override), expect or (override.split("=")[0],))
+
+
 CATALOGUE: tuple[Entry, ...] = (
     # misspelt keys and names: the nearest valid one is suggested
     _set("misspelt pipe key", "pipe.jionts=3", "pipe.jionts", "did you mean `joints`?"),
@@ -59,8 +65,11 @@ CATALOGUE: tuple[Entry, ...] = (
     _set("negative step", "simulation.dt=-1e-4", "simulation.dt"),
     _set("zero duration", "simulation.duration=0", "simulation.duration"),
     _set("NaN duration", "simulation.duration=nan", "simulation.duration"),
-    _set("output interval not a whole number of steps", "simulation.output_interval=0.00015", "whole multiple"),
-    _set("a 1 ns step: too many steps", "simulation.dt=1e-9", "simulation.dt", "simulation.max_steps"),
+    _fixed("output interval not a whole number of steps", "simulation.output_interval=0.00015", "whole multiple"),
+    _fixed("a 1 ns step: too many steps", "simulation.dt=1e-9", "simulation.dt", "simulation.max_steps"),
+    _set("adaptive steps that do not divide the output interval", "simulation.max_step=0.0003", "whole multiple"),
+    _set("a negative tolerance", "simulation.rtol=-1e-4", "simulation.rtol", "≥ 0"),
+    _set("a tolerance for an integrator without an error estimate", 'simulation.integrator="rk4"', "simulation.rtol = 0"),
     _set("zero step limit", "simulation.max_steps=0", "simulation.max_steps"),
     _set("zero Newton tolerance", "simulation.newton.tolerance=0", "simulation.newton.tolerance"),
     _set("no Newton iterations", "simulation.newton.max_iterations=0", "simulation.newton.max_iterations"),

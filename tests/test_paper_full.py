@@ -57,7 +57,9 @@ def _positions(run: ballcage.Run, body: str) -> np.ndarray:
 
 def test_the_run_completes_without_non_finite_values(paper_run):
     assert paper_run.metadata["ballcage.complete"] == "true"
-    assert paper_run.metadata["ballcage.integrator"] == "sdirk2"
+    assert paper_run.metadata["ballcage.integrator"] == "esdirk32"
+    assert float(paper_run.metadata["ballcage.rtol"]) == 1e-4
+    assert int(paper_run.metadata["ballcage.fallback_steps"]) == 0
     for name, table in paper_run.tables.items():
         for column in table.column_names:
             values = table[column]

@@ -147,14 +147,16 @@ def test_the_stubs_table_names_are_the_modules():
 
 
 def test_scene_show_lists_the_optional_tolerances_while_they_are_unset():
-    # rtol and atol have no default: unset, the steps are fixed. `scene show` says so in the
-    # [simulation] table, with unit and meaning, and stops saying it for the one that is set.
+    # The paper scene sets rtol (adaptive steps) and leaves max_step and atol to their defaults: `scene show`
+    # says so in the [simulation] table, with unit and meaning. Fixed steps (rtol = 0) print rtol and still
+    # list the other two; a generic scene without rtol lists all three.
     shown = ballcage.Scene.from_toml('kind = "drill-pipe"').to_toml(units=True)
     simulation = shown.split("[simulation]")[1].split("[simulation.newton]")[0]
-    assert "# rtol: unset, relative tolerance of esdirk32's adaptive steps" in simulation
+    assert "rtol = 0.0001  # -" in simulation and "# rtol: unset" not in simulation
+    assert "# max_step: unset, largest adaptive step (default: the output interval) [s]" in simulation
     assert "# atol: unset" in simulation and "[m, rad, m/s, rad/s]" in simulation
-    adaptive = ballcage.Scene.from_toml('kind = "drill-pipe"', ['simulation.integrator="esdirk32"', "simulation.rtol=1e-4"])
-    shown = adaptive.to_toml(units=True)
-    assert "rtol = 0.0001  # -" in shown and "# rtol: unset" not in shown
-    assert "# atol: unset" in shown
     assert tomllib.loads(shown)["simulation"]["rtol"] == 1e-4
+    fixed = ballcage.Scene.from_toml('kind = "drill-pipe"', ["simulation.rtol=0"]).to_toml(units=True)
+    assert "rtol = 0.0  # -" in fixed and "# max_step: unset" in fixed
+    generic = ballcage.Scene.from_toml(EXAMPLES[0].read_text(encoding="utf-8")).to_toml(units=True)
+    assert "# rtol: unset, relative tolerance of esdirk32's adaptive steps (absent or 0: fixed steps of dt) [-]" in generic

@@ -96,9 +96,9 @@ class VerificationError(_native.SimulationError):
 def tighter(scene: _native.Scene) -> Tighter:
     """The verification run's setting: the scene's error bound ten times tighter.
 
-    - Adaptive steps (``simulation.rtol`` set; ESDIRK3(2)): ``rtol/10``, and
-      ``atol/10`` when the scene sets ``simulation.atol`` (unset, it follows
-      rtol). ``dt``, the largest step, is kept.
+    - Adaptive steps (a positive ``simulation.rtol``; ESDIRK3(2)): ``rtol/10``,
+      and ``atol/10`` when the scene sets ``simulation.atol`` (unset, it
+      follows rtol). ``max_step``, the largest step, is kept.
     - Fixed steps: ``dt/d`` with d = ceil(10^(1/p)), p the integrator's order
       (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
       dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
@@ -110,7 +110,7 @@ def tighter(scene: _native.Scene) -> Tighter:
     """
     simulation = scene.value("simulation")
     rtol = simulation.get("rtol")
-    if rtol is not None:
+    if rtol:
         overrides = [f"simulation.rtol={rtol / TIGHTER!r}"]
         if simulation.get("atol") is not None:
             overrides.append(f"simulation.atol={simulation['atol'] / TIGHTER!r}")

@@ -8,7 +8,8 @@
 //! - dt = 0.1 ms for 0.02 s (200 steps; rapier's mesh contacts make a longer
 //!   window too slow for a bench).
 //!
-//! ballcage runs its default integrator (SDIRK2); rapier its default solver
+//! ballcage runs SDIRK2 at fixed steps (`paper_ideal_cv`; the default until
+//! 2026-11-26, when it became adaptive ESDIRK3(2)); rapier its default solver
 //! (4 substeps) against a 64 × 180 facet bore mesh, and again against the
 //! exact tube (`Bore::Exact`: ballcage's `TubeInterior` through
 //! `ballcage_shapes::ShapeDispatcher`, 5 samples per link; issue 16). Only

@@ -37,6 +37,7 @@ fn paper_scene(hinge: &str, integrator: &str, solver: &str, duration: f64) -> (D
     let mut set = vec![
         format!("pipe.hinge=\"{hinge}\""),
         format!("simulation.integrator=\"{integrator}\""),
+        "simulation.rtol=0".to_string(),
         format!("simulation.newton.linear_solver=\"{solver}\""),
         format!("simulation.duration={duration}"),
         "record.tables=[]".to_string(),

@@ -139,12 +139,15 @@ const LINKS: Group = Group::GROUP_1;
 /// Collision group of the bore mesh.
 const BORE: Group = Group::GROUP_2;
 
-/// Builds the paper's drill pipe with the ideal-CV hinge, plus `overrides`
-/// (`dotted.key=value`, as on ballcage's command line), with no recorded
-/// tables (the comparison reads forces directly).
+/// Builds the paper's drill pipe with the ideal-CV hinge at SDIRK2's fixed
+/// steps (as the peer comparison was measured; `dt` is rapier's step too),
+/// plus `overrides` (`dotted.key=value`, as on ballcage's command line),
+/// with no recorded tables (the comparison reads forces directly).
 pub fn paper_ideal_cv(overrides: &[String]) -> Result<Document, SceneError> {
     let mut all = vec![
         "pipe.hinge=\"ideal-cv\"".to_string(),
+        "simulation.integrator=\"sdirk2\"".to_string(),
+        "simulation.rtol=0".to_string(),
         "record.tables=[]".to_string(),
     ];
     all.extend(overrides.iter().cloned());

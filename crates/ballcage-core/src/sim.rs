@@ -498,6 +498,16 @@ impl Simulation {
             );
             return Some((why, true));
         }
+        if self.model.tolerance.is_some() {
+            // Adaptive steps: the integrator only gives up at 1/1024 of the
+            // largest step, so a smaller step is not the cure.
+            let why = format!(
+                "the adaptive steps went down to {:.3e} s (1/{} of the largest) without curing it",
+                self.model.dt * crate::integrate::MIN_STEP_FRACTION,
+                (1.0 / crate::integrate::MIN_STEP_FRACTION).round()
+            );
+            return Some((why, false));
+        }
         let halvings = self.workspace.stats().halvings - self.halvings_before_step;
         if halvings > 0 {
             let why = format!(

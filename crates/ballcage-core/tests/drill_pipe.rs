@@ -215,6 +215,7 @@ fn quasi_static_hinges(extra: &[&str]) -> (PerKey, f64, PerKey) {
         "simulation.duration=0.12",
         "simulation.dt=2e-7",
         "simulation.integrator=\"symplectic-euler\"",
+        "simulation.rtol=0",
         "simulation.output_interval=0.01",
         "record.tables=[\"keys\"]",
     ]
@@ -424,6 +425,7 @@ fn a_ball_key_hinge_passes_spin_at_constant_velocity() {
         "simulation.duration=0.5",
         "simulation.dt=1e-6",
         "simulation.integrator=\"symplectic-euler\"",
+        "simulation.rtol=0",
         "simulation.output_interval=0.001",
         "record.tables=[]",
     ]
@@ -645,6 +647,8 @@ fn at_rest_the_drive_and_the_hinge_both_balance_the_resisting_moment() {
             "simulation.duration=0.12".into(),
             format!("simulation.dt={dt}"),
             "simulation.integrator=\"symplectic-euler\"".into(),
+            "simulation.rtol=0".into(),
+            "simulation.rtol=0".into(),
             "simulation.output_interval=0.01".into(),
             "record.tables=[\"drive\"]".into(),
         ]
@@ -877,6 +881,7 @@ fn ideal_cv_link_under_torque(
         "simulation.duration=0.12".into(),
         "simulation.dt=1e-5".into(),
         "simulation.integrator=\"symplectic-euler\"".into(),
+        "simulation.rtol=0".into(),
         "simulation.output_interval=0.01".into(),
         "record.tables=[]".into(),
     ]

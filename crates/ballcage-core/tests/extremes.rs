@@ -64,6 +64,7 @@ fn scene(integrator: &str, dt: f64, duration: f64, extremes: &[&str]) -> Documen
     .collect();
     overrides.push(format!("simulation.duration={duration}"));
     overrides.push(format!("simulation.integrator=\"{integrator}\""));
+    overrides.push("simulation.rtol=0".into());
     overrides.push(format!("simulation.dt={dt}"));
     overrides.extend(extremes.iter().map(|s| s.to_string()));
     Document::from_toml_str("kind = \"drill-pipe\"\n", &overrides)

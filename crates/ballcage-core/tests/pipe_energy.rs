@@ -35,6 +35,7 @@ fn settle(hinge: &str, integrator: &str, dt: f64, duration: f64, law: &str) -> (
         format!("pipe.tube_contact_law=\"{law}\""),
         format!("pipe.tube_contact_points={points}"),
         format!("simulation.integrator=\"{integrator}\""),
+        "simulation.rtol=0".into(),
         format!("simulation.dt={dt:e}"),
         format!("simulation.duration={duration}"),
         "simulation.output_interval=1e-3".into(),

@@ -373,3 +373,39 @@ fn a_hardness_below_1_mpa_and_a_wear_coefficient_above_1_are_refused() {
     assert_eq!(e.path, "wear.tube_coefficient");
     assert!(e.reason.contains("must not exceed 1"), "{e}");
 }
+
+#[test]
+fn the_adaptive_steps_settings_are_checked_by_name() {
+    // The paper scene is adaptive (rtol 1e-4): a largest step must be positive and divide the
+    // output interval; rtol = 0 gives fixed steps, with which max_step and atol have no meaning.
+    let e = pipe_error_of(&["simulation.max_step=-1"]);
+    assert_eq!(e.path, "simulation.max_step");
+    assert!(e.reason.contains("positive"), "{}", e.reason);
+    let e = pipe_error_of(&["simulation.max_step=3e-4"]);
+    assert_eq!(e.path, "simulation.output_interval");
+    assert!(e.reason.contains("simulation.max_step"), "{}", e.reason);
+    for key in ["simulation.max_step=1e-3", "simulation.atol=1e-6"] {
+        let e = pipe_error_of(&["simulation.rtol=0", key]);
+        assert_eq!(e.path, key.split('=').next().unwrap());
+        assert!(
+            e.reason.contains("positive simulation.rtol"),
+            "{}",
+            e.reason
+        );
+    }
+    let e = pipe_error_of(&["simulation.rtol=-1e-4"]);
+    assert_eq!(e.path, "simulation.rtol");
+    let e = pipe_error_of(&["simulation.integrator=\"sdirk2\""]);
+    assert_eq!(e.path, "simulation.rtol");
+    assert!(e.reason.contains("set simulation.rtol = 0"), "{}", e.reason);
+    // Fixed steps of dt with rtol = 0 load, and so does a largest step of half the interval.
+    for ok in [
+        &["simulation.integrator=\"sdirk2\"", "simulation.rtol=0"][..],
+        &["simulation.max_step=5e-4"][..],
+    ] {
+        let overrides: Vec<String> = ok.iter().map(|s| s.to_string()).collect();
+        let doc =
+            ballcage_core::loader::Document::from_toml_str("kind = \"drill-pipe\"\n", &overrides);
+        assert!(doc.is_ok(), "{ok:?}: {:?}", doc.err());
+    }
+}

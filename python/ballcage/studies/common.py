@@ -89,9 +89,13 @@ def record(tables: Sequence[str]) -> str:
 
 
 def stepping(integrator: str, dt: float, output_interval: float, duration: float) -> list[str]:
-    """Overrides for the integrator, its step `dt`, the `output_interval` and the `duration` [s]."""
+    """Overrides for the integrator, its fixed step `dt`, the `output_interval` and the `duration` [s].
+
+    The steps are fixed (``simulation.rtol = 0``), whatever the scene's own tolerance.
+    """
     return [
         f"simulation.integrator={toml_value(integrator)}",
+        "simulation.rtol=0",
         f"simulation.dt={toml_value(dt)}",
         f"simulation.output_interval={toml_value(output_interval)}",
         f"simulation.duration={toml_value(duration)}",

@@ -55,11 +55,12 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         joints,
         gravity: Vec3::from(scene.world.gravity),
         integrator: scene.simulation.integrator,
-        dt: scene.simulation.dt,
+        dt: scene.simulation.step(),
         newton: scene.simulation.newton.clone(),
         tolerance: scene
             .simulation
             .rtol
+            .filter(|_| scene.simulation.adaptive())
             .map(|rtol| (rtol, scene.simulation.atol.unwrap_or(rtol))),
         threads: match scene.simulation.threads {
             0 => std::thread::available_parallelism().map_or(1, |n| n.get()),

@@ -84,7 +84,7 @@ const GROW_MAX: f64 = 5.0;
 
 /// The smallest adaptive step, as a fraction of `simulation.dt`; a step
 /// whose Newton iterations fail below it is taken by the fallback.
-const MIN_STEP_FRACTION: f64 = 1.0 / 1024.0;
+pub(crate) const MIN_STEP_FRACTION: f64 = 1.0 / 1024.0;
 
 /// What the adaptive steps and the error estimate did over a run.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -487,7 +487,7 @@ impl Implicit {
 fn too_small(h: f64, big: f64) -> Option<String> {
     (h <= MIN_STEP_FRACTION * big).then(|| {
         format!(
-            "(with the adaptive step reduced to {h:.3e} s, simulation.dt/{} or less)",
+            "(with the adaptive step reduced to {h:.3e} s, 1/{} of the largest step or less)",
             (1.0 / MIN_STEP_FRACTION) as u64
         )
     })

@@ -77,6 +77,7 @@ use super::sparselu::SparseLu;
 mod esdirk;
 
 pub use esdirk::ErrorStats;
+pub(crate) use esdirk::MIN_STEP_FRACTION;
 
 /// Which diagonally implicit scheme the Newton iterations solve the stages
 /// of: they share the iterations, the Newton matrix and the linear solver,

@@ -13,6 +13,7 @@ mod blocklu;
 mod implicit;
 mod sparselu;
 
+pub(crate) use implicit::MIN_STEP_FRACTION;
 pub use implicit::{ErrorStats, Stats};
 
 use crate::dynamics::{Accel, Dynamics, Mode};

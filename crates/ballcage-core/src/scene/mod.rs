@@ -62,10 +62,11 @@ pub enum IntegratorKind {
     /// stiffly accurate, stage order 2, with an embedded second-order
     /// estimate. The implicit stages are solved as SDIRK2's (same Newton
     /// iterations, Jacobian and linear solver); rotations by
-    /// Runge–Kutta–Munthe-Kaas. Fixed steps of `simulation.dt`, or adaptive
-    /// steps when `simulation.rtol` is set. Opt-in: no default tolerance
-    /// has been established for the paper scene yet (issue 26), and it is
-    /// not among [`IntegratorKind::ALL`] (the studies' integrators).
+    /// Runge–Kutta–Munthe-Kaas. Adaptive steps when `simulation.rtol` is
+    /// positive (the drill pipe's default, rtol = 1e-4), else fixed steps of
+    /// `simulation.dt`. Not among [`IntegratorKind::ALL`], the fixed-step
+    /// ladders of the studies; `ballcage accuracy` runs it as its second
+    /// method.
     Esdirk32,
 }
 
@@ -82,9 +83,9 @@ impl IntegratorKind {
     }
 
     /// Every established integrator, in the order of the docs: the ones the
-    /// studies (`ballcage accuracy`, `stability`) run by default. The opt-in
-    /// [`IntegratorKind::Esdirk32`] is left out until it is the default's
-    /// candidate (issue 26).
+    /// studies (`ballcage accuracy`, `stability`) run at fixed steps by
+    /// default. [`IntegratorKind::Esdirk32`], whose point is its adaptive
+    /// steps, is left out of the ladders.
     pub const ALL: [Self; 4] = [
         Self::SymplecticEuler,
         Self::Rk4,
@@ -299,9 +300,10 @@ impl Default for DivergenceSpec {
 pub struct SimulationSpec {
     /// Simulated duration [s].
     pub duration: f64,
-    /// Integrator step [s].
+    /// Fixed integrator step [s] (with adaptive steps, see `rtol`, unused).
     pub dt: f64,
-    /// Interval between recorded frames [s]; an integer multiple of `dt`.
+    /// Interval between recorded frames [s]; an integer multiple of the
+    /// step ([`SimulationSpec::step`]).
     pub output_interval: f64,
     /// Integrator.
     #[serde(default)]
@@ -323,17 +325,22 @@ pub struct SimulationSpec {
     /// a typo in the duration). Raise it to run longer. Default 1e8.
     #[serde(default = "default_max_steps")]
     pub max_steps: u64,
-    /// Relative tolerance of the adaptive steps of `esdirk32` [–]. Absent:
-    /// fixed steps of `dt` (every integrator). Set: each step's embedded
-    /// error estimate e is held to ‖e / (atol + rtol·|y|)‖_rms ≤ 1 over the
-    /// integrated bodies' positions [m], rotations [rad], velocities [m/s]
-    /// and angular velocities [rad/s], |y| the larger magnitude of the
-    /// component at the step's two ends (1 rad for rotations); `dt` is then
-    /// the largest step, and the steps land on every multiple of `dt` (so on
-    /// every recorded frame). The stages' Newton iterations then stop at
-    /// min(`newton.tolerance`, rtol/10).
+    /// Relative tolerance of the adaptive steps of `esdirk32` [–]. Absent or
+    /// 0: fixed steps of `dt` (every integrator). Positive: each step's
+    /// embedded error estimate e is held to ‖e / (atol + rtol·|y|)‖_rms ≤ 1
+    /// over the integrated bodies' positions [m], rotations [rad],
+    /// velocities [m/s] and angular velocities [rad/s], |y| the larger
+    /// magnitude of the component at the step's two ends (1 rad for
+    /// rotations); the steps are at most `max_step` and land on every
+    /// multiple of it (so on every recorded frame). The stages' Newton
+    /// iterations then stop at min(`newton.tolerance`, rtol/10).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rtol: Option<f64>,
+    /// Largest adaptive step [s] (only with a positive `rtol`); the output
+    /// interval must be a whole multiple of it. Default: the output
+    /// interval.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<f64>,
     /// Absolute tolerance of the adaptive steps [SI unit of each quantity]:
     /// one number, read as metres for positions, radians for rotations, m/s
     /// for velocities and rad/s for angular velocities. Default: `rtol`
@@ -347,7 +354,11 @@ impl SimulationSpec {
     /// The unit and meaning of each field.
     pub const FIELDS: &'static [FieldDoc] = &[
         FieldDoc::number("duration", "s", "simulated duration"),
-        FieldDoc::number("dt", "s", "integrator step"),
+        FieldDoc::number(
+            "dt",
+            "s",
+            "fixed integrator step (unused with adaptive steps, rtol > 0)",
+        ),
         FieldDoc::number(
             "output_interval",
             "s",
@@ -376,8 +387,12 @@ impl SimulationSpec {
         FieldDoc::optional(
             "rtol",
             "-",
-            "relative tolerance of esdirk32's adaptive steps (absent: fixed steps of dt, \
-             the largest step when set)",
+            "relative tolerance of esdirk32's adaptive steps (absent or 0: fixed steps of dt)",
+        ),
+        FieldDoc::optional(
+            "max_step",
+            "s",
+            "largest adaptive step (default: the output interval)",
         ),
         FieldDoc::optional(
             "atol",
@@ -421,7 +436,9 @@ impl SimulationSpec {
                 format!("must be at most {MAX_THREADS} (0 takes one per core)"),
             ));
         }
-        let steps = (self.duration / self.dt).ceil();
+        // The step (and so the step count) needs the tolerances checked first.
+        self.validate_tolerances()?;
+        let steps = (self.duration / self.step()).ceil();
         if self.max_steps == 0 {
             return Err(SceneError::new(
                 "simulation.max_steps",
@@ -440,17 +457,18 @@ impl SimulationSpec {
                 ),
             ));
         }
-        if whole_multiple(self.output_interval, self.dt).is_none() {
+        let (name, step) = if self.adaptive() {
+            ("simulation.max_step", self.step())
+        } else {
+            ("simulation.dt", self.dt)
+        };
+        if whole_multiple(self.output_interval, step).is_none() {
             return Err(SceneError::new(
                 "simulation.output_interval",
                 self.output_interval,
-                format!(
-                    "must be a whole multiple (≥ 1) of simulation.dt = {} s",
-                    self.dt
-                ),
+                format!("must be a whole multiple (≥ 1) of {name} = {step} s"),
             ));
         }
-        self.validate_tolerances()?;
         positive("simulation.newton.tolerance", self.newton.tolerance)?;
         if self.newton.max_iterations == 0 {
             return Err(SceneError::new(
@@ -472,30 +490,62 @@ impl SimulationSpec {
 }
 
 impl SimulationSpec {
-    /// Checks `rtol` and `atol`: positive, `atol` only with `rtol`, and
+    /// Whether the steps are adaptive: a positive `rtol`.
+    pub fn adaptive(&self) -> bool {
+        self.rtol.is_some_and(|r| r > 0.0)
+    }
+
+    /// The step the run advances by between the integrator's calls [s]:
+    /// `dt`, or with adaptive steps `max_step` (default the output interval),
+    /// within which the integrator takes its own steps.
+    pub fn step(&self) -> f64 {
+        if self.adaptive() {
+            self.max_step.unwrap_or(self.output_interval)
+        } else {
+            self.dt
+        }
+    }
+
+    /// Checks `rtol`, `atol` and `max_step`: `rtol` ≥ 0 (0: fixed steps),
+    /// `atol` and `max_step` positive and only with a positive `rtol`, and
     /// adaptive steps only for the integrator that has an error estimate.
     fn validate_tolerances(&self) -> Result<(), SceneError> {
-        if let Some(atol) = self.atol {
-            positive("simulation.atol", atol)?;
-            if self.rtol.is_none() {
-                return Err(SceneError::new(
-                    "simulation.atol",
-                    atol,
-                    "needs simulation.rtol (adaptive steps); without it the steps are fixed",
-                ));
+        let needs = |key: &str, value: f64| {
+            SceneError::new(
+                key,
+                value,
+                "needs a positive simulation.rtol (adaptive steps); without it the steps are fixed",
+            )
+        };
+        for (key, value) in [
+            ("simulation.atol", self.atol),
+            ("simulation.max_step", self.max_step),
+        ] {
+            if let Some(v) = value {
+                positive(key, v)?;
+                if !self.adaptive() {
+                    return Err(needs(key, v));
+                }
             }
         }
         let Some(rtol) = self.rtol else {
             return Ok(());
         };
-        positive("simulation.rtol", rtol)?;
-        if self.integrator != IntegratorKind::Esdirk32 {
+        if !(rtol.is_finite() && rtol >= 0.0) {
+            return Err(SceneError::new(
+                "simulation.rtol",
+                rtol,
+                "must be a finite number ≥ 0 (0: fixed steps of simulation.dt)",
+            ));
+        }
+        if rtol > 0.0 && self.integrator != IntegratorKind::Esdirk32 {
             return Err(SceneError::new(
                 "simulation.rtol",
                 rtol,
                 format!(
                     "adaptive steps need an error estimate: only simulation.integrator = \
-                     \"esdirk32\" has one (it is \"{}\")",
+                     \"esdirk32\" has one (it is \"{}\"); for fixed steps of simulation.dt \
+                     set simulation.rtol = 0",
                     self.integrator.name()
                 ),
             ));
@@ -855,12 +905,12 @@ impl Scene {
 
     /// Number of integrator steps per recorded frame.
     pub fn steps_per_output(&self) -> u64 {
-        (self.simulation.output_interval / self.simulation.dt).round() as u64
+        (self.simulation.output_interval / self.simulation.step()).round() as u64
     }
 
     /// Total number of integrator steps.
     pub fn total_steps(&self) -> u64 {
-        let n = (self.simulation.duration / self.simulation.dt).round() as u64;
+        let n = (self.simulation.duration / self.simulation.step()).round() as u64;
         n.max(1)
     }
 }
