@@ -55,8 +55,8 @@ RELATIVE = (
     "1e-3 rad/s, 1 mJ); a unit without a floor has none, and rel_difference is null when verify_value is zero and "
     "run_value is not; a quantity without a unit (a part number) has none; 0 where the values are equal"
 )
-#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' integrators, not the
-#: opt-in ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
+#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' fixed-step integrators,
+#: not ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
 _OPT_IN_ORDERS = {"esdirk32": 3}
 #: The columns of ``verify.parquet``: name -> (Arrow type name, unit, description).
 COLUMNS: dict[str, tuple[str, str, str]] = {
