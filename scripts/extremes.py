@@ -18,6 +18,7 @@ import json
 import time
 
 import ballcage
+from ballcage.studies.common import newton_per_stage
 
 EXTREMES: dict[str, list[str]] = {
     "the paper's scene (reference)": [],
@@ -43,15 +44,8 @@ def one(overrides: list[str]) -> dict:
     except ballcage.SimulationError as e:
         meta, finished = e.run.metadata, f"no: {e}"  # type: ignore[attr-defined]
     keys = ("newton_iterations", "steps", "accepted_steps", "rejected_steps", "step_halvings", "fallback_steps")
-    return {"finished": finished, "cpu_s": time.process_time() - start, **{k: meta.get(f"ballcage.{k}") for k in keys}}
-
-
-def per_stage(r: dict) -> float:
-    """Newton iterations per implicit stage (SDIRK2: 2 per step; ESDIRK3(2): 3 per attempted step)."""
-    its = float(r["newton_iterations"] or 0)
-    if r["accepted_steps"] is not None:
-        return its / (3 * (int(r["accepted_steps"]) + int(r["rejected_steps"])))
-    return its / (2 * (int(r["steps"]) + int(r["step_halvings"])))
+    counts = {k: meta.get(f"ballcage.{k}") for k in keys}
+    return {"finished": finished, "cpu_s": time.process_time() - start, "per_stage": newton_per_stage(meta) or float("nan"), **counts}
 
 
 def main() -> None:
@@ -73,7 +67,7 @@ def main() -> None:
     print("|---|---|---:|---:|---:|---:|---:|")
     for name, r in results.items():
         print(
-            f"| {name} | {r['finished']} | {r['cpu_s']:.1f} | {per_stage(r):.2f} | "
+            f"| {name} | {r['finished']} | {r['cpu_s']:.1f} | {r['per_stage']:.2f} | "
             f"{r['rejected_steps'] or '—'} | {r['step_halvings']} | {r['fallback_steps']} |"
         )
 

@@ -21,6 +21,7 @@ import json
 import time
 
 import ballcage
+from ballcage.studies.common import newton_per_stage
 from ballcage.verify import headline
 
 ESDIRK = ['simulation.integrator="esdirk32"']
@@ -49,6 +50,7 @@ def measure(overrides: list[str], duration: float) -> dict:
     return {
         "wall_s": time.perf_counter() - start,
         "meta": {k: meta.get(f"ballcage.{k}") for k in keys},
+        "per_stage": newton_per_stage(meta) or float("nan"),
         "quantities": {name: value for name, (_, value) in headline(run).items()},
     }
 
@@ -62,14 +64,6 @@ def largest_difference(run: dict, reference: dict) -> tuple[float, str]:
             continue
         worst = max(worst, (abs(a - b) / abs(b), name))
     return worst
-
-
-def per_stage(meta: dict) -> float:
-    """Newton iterations per implicit stage: SDIRK2 has 2 per step, ESDIRK3(2) 3 per attempted step."""
-    iterations = float(meta["newton_iterations"] or 0)
-    if meta["accepted_steps"] is not None:
-        return iterations / (3 * (int(meta["accepted_steps"]) + int(meta["rejected_steps"])))
-    return iterations / (2 * (int(meta["steps"]) + int(meta["step_halvings"])))
 
 
 def main() -> None:
@@ -91,7 +85,7 @@ def main() -> None:
         diff, quantity = largest_difference(r, reference)
         shown = "—" if r is reference else f"{100 * diff:.3g} % ({quantity})"
         print(
-            f"| {name} | {r['wall_s']:.1f} | {m['real_time_factor']} | {per_stage(m):.2f} | "
+            f"| {name} | {r['wall_s']:.1f} | {m['real_time_factor']} | {r['per_stage']:.2f} | "
             f"{m['rejected_steps'] or '—'} | {m['step_halvings']} | {m['fallback_steps']} | {shown} |"
         )
 

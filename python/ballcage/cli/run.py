@@ -22,6 +22,7 @@ from ballcage.cli._common import (
     names,
 )
 from ballcage.run import VERIFY_FILE, Run, simulate
+from ballcage.studies.common import implicit_steps, newton_per_stage
 from ballcage.verify import VerificationError, disagreements, verdict
 
 
@@ -158,20 +159,17 @@ def _cost(meta: dict[str, str]) -> str:
         f"ballcage: {simulated:.4g} s simulated in {float(meta['ballcage.wall_time_s']):.3g} s of wall time "
         f"(real-time factor {float(meta['ballcage.real_time_factor']):.3g}); "
     )
-    accepted = meta.get("ballcage.accepted_steps")
-    if accepted is not None:
+    if meta.get("ballcage.accepted_steps") is not None:
         # Adaptive steps (ESDIRK3(2) at simulation.rtol): the steps the integrator chose.
-        taken = int(accepted) + int(meta["ballcage.rejected_steps"])
         line += (
-            f"{meta['ballcage.integrator']} adaptive at rtol {float(meta['ballcage.rtol']):g}, {accepted} steps "
-            f"({meta['ballcage.rejected_steps']} rejected, smallest {float(meta['ballcage.smallest_step_s']):.3g} s)"
+            f"{meta['ballcage.integrator']} adaptive at rtol {float(meta['ballcage.rtol']):g}, "
+            f"{meta['ballcage.accepted_steps']} steps ({meta['ballcage.rejected_steps']} rejected, "
+            f"smallest {float(meta['ballcage.smallest_step_s']):.3g} s)"
         )
-        stages, taken_steps = 3 * taken, taken
     else:
         line += f"{meta['ballcage.integrator']} at {float(meta['ballcage.dt_s']):g} s, {steps} steps"
-        stages, taken_steps = (2 * steps if meta["ballcage.integrator"] == "sdirk2" else 0), steps
-    if stages > 0:
-        per_stage = int(meta["ballcage.newton_iterations"]) / stages
-        per_step = int(meta["ballcage.factorizations"]) / taken_steps
+    taken, per_stage = implicit_steps(meta), newton_per_stage(meta)
+    if taken is not None and per_stage is not None:
+        per_step = int(meta["ballcage.factorizations"]) / taken[0]
         line += f", {per_stage:.2f} Newton iterations per stage, {per_step:.2f} factorizations per step"
     return line

@@ -116,6 +116,28 @@ def meta_int(meta: Mapping[str, str], key: str) -> int | None:
         return None
 
 
+def implicit_steps(meta: Mapping[str, str]) -> tuple[int, int] | None:
+    """Steps an implicit run's integrator took and the implicit stages they solved, from its metadata.
+
+    ESDIRK3(2) with adaptive steps: its accepted and rejected steps, three implicit stages each; SDIRK2: its
+    steps and the part steps its halvings added, two stages each. ``None`` for the other integrators (and for
+    ESDIRK3(2) at fixed steps, whose stages per part step the metadata does not say).
+    """
+    accepted, rejected = meta_int(meta, "ballcage.accepted_steps"), meta_int(meta, "ballcage.rejected_steps")
+    if accepted is not None and rejected is not None:
+        return accepted + rejected, 3 * (accepted + rejected)
+    steps, halvings = meta_int(meta, "ballcage.steps"), meta_int(meta, "ballcage.step_halvings") or 0
+    if meta.get("ballcage.integrator") == "sdirk2" and steps:
+        return steps + halvings, 2 * (steps + halvings)
+    return None
+
+
+def newton_per_stage(meta: Mapping[str, str]) -> float | None:
+    """Newton iterations per implicit stage of a run, from its metadata; ``None`` where `implicit_steps` is."""
+    taken, iterations = implicit_steps(meta), meta_int(meta, "ballcage.newton_iterations")
+    return iterations / taken[1] if taken and taken[1] and iterations is not None else None
+
+
 def study_meta(table: pa.Table) -> dict[str, str]:
     """A study table's schema metadata, decoded."""
     return {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
