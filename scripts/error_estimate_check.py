@@ -4,7 +4,7 @@
     python3 scripts/error_estimate_check.py [--out FILE.json]
 
 For the paper scene and three extremes, runs the default (ESDIRK3(2), rtol 1e-4) and the same scene at
-rtol 1e-5, and compares:
+rtol 1e-5 (ten times tighter), and compares:
 - the run's `ballcage.error_estimate_position_m` (the sum over its accepted steps of the largest local
   error estimate on a position) with the largest difference of any body's position between the two runs,
   over every recorded frame ("measured", m);

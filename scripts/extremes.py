@@ -4,8 +4,8 @@
     python3 scripts/extremes.py [--integrator NAME --rtol R] [--out FILE.json]
 
 Runs the embedded paper scene (ball keys, 1.8 s) with each extreme below, by
-default with the shipped setting (ESDIRK3(2), adaptive at rtol 1e-4, steps up
-to 1 ms); `--integrator sdirk2 --rtol 0` runs them at SDIRK2's fixed 100 µs. Prints a markdown table:
+default with the shipped setting (ESDIRK3(2), adaptive at rtol 1e-4, frames
+within steps interpolated); `--integrator sdirk2 --rtol 0` runs them at SDIRK2's fixed 100 µs. Prints a markdown table:
 whether the run finished, its CPU time [s], Newton iterations per stage,
 rejected steps, step halvings and first-order fallback part steps.
 Takes 5–10 minutes on this project's machine.

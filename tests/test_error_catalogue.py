@@ -67,7 +67,7 @@ CATALOGUE: tuple[Entry, ...] = (
     _set("NaN duration", "simulation.duration=nan", "simulation.duration"),
     _fixed("output interval not a whole number of steps", "simulation.output_interval=0.00015", "whole multiple"),
     _fixed("a 1 ns step: too many steps", "simulation.dt=1e-9", "simulation.dt", "simulation.max_steps"),
-    _set("adaptive steps that do not divide the output interval", "simulation.max_step=0.0003", "whole multiple"),
+    _set("a negative largest adaptive step", "simulation.max_step=-0.001", "simulation.max_step", "positive"),
     _set("a negative tolerance", "simulation.rtol=-1e-4", "simulation.rtol", "≥ 0"),
     _set("a tolerance for an integrator without an error estimate", 'simulation.integrator="rk4"', "simulation.rtol = 0"),
     _set("zero step limit", "simulation.max_steps=0", "simulation.max_steps"),

@@ -46,7 +46,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("buckling", ("_native", "scene", "run")),
     ("measures", ("_native", "run", "_links")),
     ("view", ("_native", "_files", "_plot", "run")),
-    ("studies", ("_native", "_files", "_plot", "scene", "run", "_links", "sizing", "measures")),
+    ("studies", ("_native", "_files", "_plot", "scene", "run", "_links", "duty", "sizing", "measures")),
     ("verify", ("_native", "run", "studies")),
     ("paper", ("_native", "_files", "_plot", "scene", "run", "_links", "duty", "measures", "view", "studies")),
     ("cli", _LIBRARY),

@@ -177,7 +177,7 @@ def test_public_api_is_curated():
     assert set(ballcage.__all__) == {
         "DrillPipeBuilder", "Error", "InputError", "InternalError", "Run", "Scene", "SceneBuilder", "SceneError",
         "Simulation", "SimulationError", "__version__", "buckling", "largest_link_diameter", "load_scene",
-        "longest_link", "simulate", "table_schema", "tightest_radius_for_link",
+        "longest_link", "proposals", "simulate", "table_schema", "tightest_radius_for_link",
     }
     # one base class for every error, each also the built-in exception code written before it catches
     assert issubclass(ballcage.SceneError, ballcage.Error) and issubclass(ballcage.SceneError, ValueError)

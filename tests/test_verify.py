@@ -82,15 +82,19 @@ def test_adaptive_steps_tighten_rtol_and_a_set_atol_tenfold_and_keep_dt():
     with_atol = ballcage.load_scene(TWO_BALLS, [*adaptive, "simulation.atol=1e-6"])
     check = ballcage.load_scene(with_atol, tighter(with_atol).overrides)
     assert check.value("simulation.atol") == pytest.approx(1e-7)
+    per_quantity = ballcage.load_scene(TWO_BALLS, [*adaptive, "simulation.atol_velocity=1e-3"])
+    check = ballcage.load_scene(per_quantity, tighter(per_quantity).overrides)
+    assert check.value("simulation.atol_velocity") == pytest.approx(1e-4)
+    assert "atol" not in check.value("simulation")
 
 
 def test_an_adaptive_run_is_verified_at_rtol_over_ten_and_its_error_falls_with_rtol():
-    # dt = 100 us, the largest step, so that rtol and not dt sets the steps through the impact
+    # max_step = 100 us, so that rtol and not the first step sets the steps through the impact
     largest = {}
     for rtol in (1e-3, 1e-4):
         run = ballcage.simulate(
             TWO_BALLS,
-            overrides=['simulation.integrator="esdirk32"', "simulation.dt=1e-4", f"simulation.rtol={rtol!r}"],
+            overrides=['simulation.integrator="esdirk32"', "simulation.max_step=1e-4", f"simulation.rtol={rtol!r}"],
             progress=False,
             verify=True,
         )

@@ -13,7 +13,8 @@ A scene is a TOML file, a dict of the same structure, or a `SceneBuilder`;
 Every error ballcage raises is a `ballcage.Error`: `SceneError` (a scene field),
 `SimulationError` (a run that diverged), `InputError` (a function argument),
 `InternalError` (a bug: a Rust panic, caught), the studies' `StudyError`
-and `SweepError`, and `ballcage.verify.VerificationError` (a `SimulationError`).
+and `SweepError`, `ballcage.verify.VerificationError` (a `SimulationError`)
+and `ballcage.run.TimeLimitError` (a run past ``simulate(..., time_limit=)``).
 ``ballcage.simulate(scene, verify=True)`` repeats the run ten times tighter
 and keeps the difference of each headline quantity as the run's measured
 error, ``run.verification`` (``ballcage run --verify``; `ballcage.verify`).
@@ -22,11 +23,15 @@ All quantities are SI; units are in each output column's field metadata.
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and
 `ballcage.paper.run_paper(dir)` runs it and writes the tables, the paper's
 figures and a comparison with the paper's numbers (``ballcage paper``).
+`ballcage.proposals()` is the registry of the values the paper does not give (PROPOSALs): each with its
+default, plausible range and why, as a `pyarrow.Table` (docs/proposals.md).
 `ballcage.sizing` is the paper's link-sizing eq. (9) both ways (``ballcage size``):
 `longest_link`, `tightest_radius_for_link`, `largest_link_diameter`.
 `ballcage.studies.accuracy` and `ballcage.studies.stability` measure what
 each integrator's step costs in error and where it stops being stable
-(``ballcage accuracy``, ``ballcage stability``).
+(``ballcage accuracy``, ``ballcage stability``); ``ballcage.sensitivity(scene, out)``
+measures how much each unstated parameter moves each headline quantity
+(``ballcage sensitivity``, `ballcage.studies.sensitivity_run`).
 """
 
 import importlib as _importlib
@@ -48,7 +53,7 @@ from ballcage import run as _run
 from ballcage import verify as _verify
 from ballcage.buckling import buckling
 from ballcage.run import Run, simulate
-from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene
+from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene, proposals
 from ballcage.sizing import largest_link_diameter, longest_link, tightest_radius_for_link
 
 # `simulate(..., verify=True)` measures the run's error with `ballcage.verify.verify`, which lies above
@@ -73,6 +78,7 @@ __all__ = [
     "largest_link_diameter",
     "load_scene",
     "longest_link",
+    "proposals",
     "simulate",
     "table_schema",
     "tightest_radius_for_link",
@@ -99,4 +105,6 @@ def __getattr__(name: str) -> _Any:
         return getattr(_importlib.import_module("ballcage.sizing"), name)
     if name == "sweep":  # `ballcage.sweep(spec, out, client=...)`: ballcage.studies.sweep_run.sweep
         return _importlib.import_module("ballcage.studies.sweep_run").sweep
+    if name == "sensitivity":  # `ballcage.sensitivity(scene, out, ...)`: ballcage.studies.sensitivity_run.sensitivity
+        return _importlib.import_module("ballcage.studies.sensitivity_run").sensitivity
     raise AttributeError(f"module 'ballcage' has no attribute {name!r}")

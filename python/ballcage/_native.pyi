@@ -22,6 +22,7 @@ __all__ = [
     "Scene",
     "Simulation",
     "default_scene_toml",
+    "proposals",
     "integrator_facts",
     "table_schema",
     "whole_multiple",
@@ -94,7 +95,10 @@ class Scene:
 
         With `units`, each line that sets a number ends in a comment naming its
         unit (``pitch = 0.2  # m``; contact laws in their own ``units``, e.g.
-        ``# N/mm^2.2``); the text parses to the same values.
+        ``# N/mm^2.2``), and each PROPOSAL (a value the paper does not give,
+        `proposals`) follows a comment line with its plausible range and source
+        (``# PROPOSAL, 17.5–21 mm: not in the paper``); the text parses to the
+        same values.
         """
 
     @property
@@ -238,6 +242,15 @@ def whole_multiple(interval: float, step: float) -> int | None:
 
 def default_scene_toml() -> str:
     """The embedded default scene (the paper's drill pipe, ``kind = "drill-pipe"``) as TOML, every default written out."""
+
+def proposals(kind: Literal["generic", "drill-pipe"] | None = None) -> list[dict[str, Any]]:
+    """The registry of unstated parameters (PROPOSAL values), one dict per entry; `ballcage.proposals` makes
+    it a table.
+
+    Keys ``key``, ``scene_kind``, ``default``, ``low``, ``high`` (floats, in ``unit``), ``unit``, ``source``
+    (``"invented"``, ``"paper-reading"`` or ``"handbook"``), ``reference``, ``meaning`` and ``range_reason``.
+    `kind` keeps one scene kind's entries. Raises `InputError` for another `kind`.
+    """
 
 def longest_link(curvature_radius: float, tube_inner_diameter: float, link_outer_diameter: float) -> float:
     """The paper's eq. (9): the longest rigid link [m] of outer diameter `link_outer_diameter` [m] that fits

@@ -5,6 +5,10 @@ about `CHUNKS` pieces so that Ctrl-C is honoured between pieces and a progress
 bar can be drawn; the chunking does not change the result (the integrator
 steps are the same).
 
+``simulate(..., time_limit=SECONDS)`` stops a run whose wall time passes the
+limit at the next of those pieces and raises `TimeLimitError` with the
+frames recorded so far (the sweeps' ``--case-timeout``).
+
 ``simulate(..., verify=True)`` repeats the run ten times tighter and keeps the
 difference of each headline quantity as the run's measured error
 (`Verification`, ``verify.parquet``). That work is `ballcage.verify.verify`,
@@ -16,6 +20,7 @@ package's facade (``ballcage/__init__.py``) sets, so it never imports it.
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import time
@@ -31,7 +36,7 @@ from ballcage.scene import SceneSource, load_scene
 if TYPE_CHECKING:
     import pyarrow as pa
 
-__all__ = ["VERIFY_FILE", "Run", "Verification", "simulate"]
+__all__ = ["VERIFY_FILE", "Run", "TimeLimitError", "Verification", "simulate"]
 
 #: Number of `advance` calls a run is split into.
 CHUNKS = 200
@@ -62,6 +67,29 @@ class Verification:
     quantity: str | None
     #: Wall time of the verification run over the run's (``ballcage.wall_time_s``); ``None`` if not measured.
     time_ratio: float | None
+
+
+class TimeLimitError(_native.Error, TimeoutError):
+    """A run stopped because its wall time passed ``simulate(..., time_limit=)``.
+
+    Not a `ballcage.SimulationError`: the run did not diverge, it was stopped.
+    ``run`` holds the frames recorded up to then (a `Run` whose
+    ``Run.error`` is this message, ``Run.complete`` false); ``limit_s`` is the
+    limit, ``elapsed_s`` the wall time when the run stopped and ``t_s`` the
+    simulated time reached [s].
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        run: Run | None = None,
+        limit_s: float | None = None,
+        elapsed_s: float | None = None,
+        t_s: float | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.run, self.limit_s, self.elapsed_s, self.t_s = run, limit_s, elapsed_s, t_s
 
 
 #: ``VERIFIER(run, progress)`` measures a complete run's error for ``simulate(..., verify=True)``:
@@ -220,6 +248,7 @@ def simulate(
     overrides: Iterable[str] = (),
     progress: bool | None = None,
     verify: bool = False,
+    time_limit: float | None = None,
 ) -> Run:
     """Runs a scene to its duration and returns the recorded tables.
 
@@ -246,11 +275,19 @@ def simulate(
     When the verification run fails, `ballcage.verify.VerificationError` (a
     `SimulationError`) carries the complete run, unverified, as ``e.run``; an
     interrupt during the verification run carries it too.
+
+    `time_limit`: wall time [s] the run may take (``None``: no limit). The
+    run is checked between the `CHUNKS` pieces it is advanced in (the engine
+    cannot be stopped inside one), so it stops at most one piece, 1/200 of
+    its simulated time, after the limit, raising `TimeLimitError` with the
+    frames recorded up to then as ``e.run``. The verification run has no limit.
     """
+    if time_limit is not None and not (math.isfinite(time_limit) and time_limit > 0):
+        raise _native.InputError(f"time_limit = {time_limit!r}: must be a positive number of seconds (None: no limit)")
     resolved = load_scene(scene, overrides)
     if verify and "summary" not in resolved.table_names:
         resolved = load_scene(resolved, ["record.tables=" + json.dumps([*resolved.table_names, "summary"])])
-    run = _run(resolved, progress)
+    run = _run(resolved, progress, time_limit)
     if verify:
         if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
             raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
@@ -258,8 +295,9 @@ def simulate(
     return run
 
 
-def _run(resolved: _native.Scene, progress: bool | None) -> Run:
-    """`simulate` of a validated scene, without verification."""
+def _run(resolved: _native.Scene, progress: bool | None, time_limit: float | None = None) -> Run:
+    """`simulate` of a validated scene, without verification; stopped past `time_limit` [s] of wall time."""
+    start = time.monotonic()
     sim = _native.Simulation(resolved)
     duration = sim.duration
     bar = _ProgressBar(progress, duration)
@@ -267,6 +305,9 @@ def _run(resolved: _native.Scene, progress: bool | None) -> Run:
         for i in range(1, CHUNKS + 1):
             sim.advance(duration if i == CHUNKS else duration * i / CHUNKS)
             bar.update(sim.time)
+            elapsed = time.monotonic() - start
+            if time_limit is not None and elapsed > time_limit and i < CHUNKS:
+                raise _past_limit(sim, resolved, time_limit, elapsed)
     except _native.SimulationError as e:
         # The native Simulation stays usable after an error: hand over what it
         # recorded (its metadata has ballcage.complete = "false" and ballcage.error).
@@ -279,6 +320,17 @@ def _run(resolved: _native.Scene, progress: bool | None) -> Run:
     finally:
         bar.close()
     return Run(sim.finish(), resolved.to_toml(), scene=resolved)
+
+
+def _past_limit(sim: _native.Simulation, resolved: _native.Scene, limit: float, elapsed: float) -> TimeLimitError:
+    """The `TimeLimitError` of a run stopped at `elapsed` s past its `limit`, with the frames recorded so far."""
+    t, duration = sim.time, sim.duration
+    message = (
+        f"run stopped after {elapsed:.3g} s of wall time, past its time limit of {limit:.3g} s, "
+        f"at t = {t:.6g} s of {duration:.6g} s"
+    )
+    run = Run(sim.finish(), resolved.to_toml(), error=message, scene=resolved)
+    return TimeLimitError(message, run=run, limit_s=limit, elapsed_s=elapsed, t_s=t)
 
 
 class _ProgressBar:

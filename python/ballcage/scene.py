@@ -22,10 +22,13 @@ import errno
 import os
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, Self, TypeAlias
+from typing import TYPE_CHECKING, Any, Self, TypeAlias
 
 from ballcage import _native
 from ballcage._native import InputError
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 __all__ = [
     "DrillPipeBuilder",
@@ -35,6 +38,7 @@ __all__ = [
     "default_scene_toml",
     "load_scene",
     "override_list",
+    "proposals",
 ]
 
 
@@ -253,6 +257,44 @@ def default_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     expanded scene that ``Scene.to_toml()`` returns. Raises `ballcage.SceneError`.
     """
     return _native.Scene.from_toml(_native.default_scene_toml(), override_list(overrides))
+
+
+#: The columns of `proposals`, in order: (name, Arrow type, meaning).
+PROPOSAL_COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("key", "string", "dotted scene key, as --set key=value takes it"),
+    ("scene_kind", "string", "the scene kind whose default it is: drill-pipe, or generic (the engine's, every kind)"),
+    ("default", "float64", "the default scene's value, in unit"),
+    ("low", "float64", "lowest plausible value, in unit"),
+    ("high", "float64", "highest plausible value, in unit"),
+    ("unit", "string", "the field's unit in the default scene (a contact law's in its N-mm-s field units); - pure"),
+    ("source", "string", "invented, paper-reading (our reading of the paper) or handbook"),
+    ("reference", "string", "where the default comes from: the argument or the citation"),
+    ("meaning", "string", "what the field is"),
+    ("range_reason", "string", "why the range is plausible"),
+)
+
+
+def proposals(kind: str | None = None) -> pa.Table:
+    """The registry of unstated parameters: every default ballcage chose because the paper gives none.
+
+    One row per PROPOSAL value, with the columns of `PROPOSAL_COLUMNS`: ``key`` (dotted, as ``--set`` takes
+    it), ``scene_kind`` (``"drill-pipe"``, or ``"generic"`` for the engine's own, which every scene kind
+    has), ``default``, ``low`` and ``high`` (float64, in ``unit``, the field's unit in the default scene:
+    a contact law's in its N-mm-s field units), ``source`` (``"invented"``, ``"paper-reading"`` or
+    ``"handbook"``), ``reference``, ``meaning`` and ``range_reason``. `kind` (``"drill-pipe"`` or
+    ``"generic"``) keeps one kind's rows. The registry is defined once in Rust beside the spec fields; the
+    default, unit and meaning come from the default scene and the table of field units (docs/proposals.md).
+    Raises `ballcage.InputError` for an unknown `kind`.
+    """
+    import pyarrow as pa  # deferred: `import ballcage` stays light
+
+    if kind is not None and not isinstance(kind, str):
+        raise InputError(f"kind = {kind!r}: give a scene kind name, e.g. 'drill-pipe', or None for every kind")
+    schema = pa.schema(
+        [pa.field(name, pa.type_for_alias(type_), nullable=False, metadata={"description": meaning})
+         for name, type_, meaning in PROPOSAL_COLUMNS]
+    )  # fmt: skip
+    return pa.Table.from_pylist(_native.proposals(kind), schema=schema)
 
 
 def override_list(overrides: Iterable[str]) -> list[str]:

@@ -2,7 +2,8 @@
 
 ``ballcage run --verify`` and ``simulate(..., verify=True)`` call `verify` on
 the finished run (`ballcage.run.VERIFIER`). It reruns the scene at the
-setting `tighter` gives (``dt/4`` for SDIRK2, ``rtol/10`` for adaptive steps),
+setting `tighter` gives (``dt/4`` for SDIRK2, ``rtol/10`` for adaptive steps;
+the rule lives in `ballcage.studies.refinement`, which ``ballcage sensitivity`` shares),
 takes the headline quantities of both runs (`headline`: the drill pipe's
 comparison quantities, `ballcage.measures.DRILL_PIPE`, as
 `ballcage.studies.sweep_quantities.for_scene` picks them; a generic scene's
@@ -26,16 +27,17 @@ import json
 import math
 import sys
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
 from ballcage.run import Run, Verification, simulate
+from ballcage.studies.refinement import TIGHTER, Tighter, tighter
 
 if TYPE_CHECKING:
     import pyarrow as pa
 
 __all__ = [
+    "TIGHTER",
     "Tighter",
     "VerificationError",
     "compare",
@@ -46,8 +48,6 @@ __all__ = [
     "verify",
 ]
 
-#: A run's error bound falls by this factor in the verification run.
-TIGHTER = 10
 #: The rule of ``verify.parquet``'s relative difference (also in its schema metadata, ``ballcage.verify.relative``).
 RELATIVE = (
     "rel_difference = |run_value - verify_value| / max(|verify_value|, floor), floor the quantity's natural scale "
@@ -55,9 +55,6 @@ RELATIVE = (
     "1e-3 rad/s, 1 mJ); a unit without a floor has none, and rel_difference is null when verify_value is zero and "
     "run_value is not; a quantity without a unit (a part number) has none; 0 where the values are equal"
 )
-#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' fixed-step integrators,
-#: not ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
-_OPT_IN_ORDERS = {"esdirk32": 3}
 #: The columns of ``verify.parquet``: name -> (Arrow type name, unit, description).
 COLUMNS: dict[str, tuple[str, str, str]] = {
     "quantity": ("string", "", "headline quantity: a drill pipe's comparison quantity (as in a sweep's summary.parquet) "
@@ -73,14 +70,6 @@ COLUMNS: dict[str, tuple[str, str, str]] = {
 }  # fmt: skip
 
 
-@dataclass(frozen=True)
-class Tighter:
-    """The verification run's setting: its `label` (``"dt/4"``, ``"rtol/10"``) and the `overrides` that make it."""
-
-    label: str
-    overrides: tuple[str, ...]
-
-
 class VerificationError(_native.SimulationError):
     """The verification run failed (it diverged, or its scene was refused, e.g. by ``simulation.max_steps``).
 
@@ -91,34 +80,6 @@ class VerificationError(_native.SimulationError):
 
     run: Run
     check: Run | None
-
-
-def tighter(scene: _native.Scene) -> Tighter:
-    """The verification run's setting: the scene's error bound ten times tighter.
-
-    - Adaptive steps (a positive ``simulation.rtol``; ESDIRK3(2)): ``rtol/10``,
-      and ``atol/10`` when the scene sets ``simulation.atol`` (unset, it
-      follows rtol). ``max_step``, the largest step, is kept.
-    - Fixed steps: ``dt/d`` with d = ceil(10^(1/p)), p the integrator's order
-      (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
-      dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
-      by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
-      step, so the frames are the same.
-
-    Every other field (the Newton tolerance, ``max_steps``) is kept: a
-    ``max_steps`` the d times more steps exceed makes the verification fail.
-    """
-    simulation = scene.value("simulation")
-    rtol = simulation.get("rtol")
-    if rtol:
-        overrides = [f"simulation.rtol={rtol / TIGHTER!r}"]
-        if simulation.get("atol") is not None:
-            overrides.append(f"simulation.atol={simulation['atol'] / TIGHTER!r}")
-        return Tighter(f"rtol/{TIGHTER}", tuple(overrides))
-    name = simulation["integrator"]
-    order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
-    d = math.ceil(TIGHTER ** (1.0 / order))
-    return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
 
 
 def verify(run: Run, *, progress: bool | None = None) -> Verification:
@@ -176,28 +137,14 @@ def headline(run: Run) -> dict[str, tuple[str, float | None]]:
     of each contact pair, ``<statistic>[<pair>]`` for every column of the
     ``summary`` table in N (empty without that table).
     """
-    from ballcage.studies.sweep_quantities import for_scene  # deferred: numpy, the measures
+    from ballcage.studies.sweep_quantities import for_scene, summary_statistics  # deferred: numpy, the measures
 
     plugin = for_scene(run.scene)
     values = plugin(run)
     if not values:
-        return _summary_statistics(run)
+        return summary_statistics(run)
     columns = plugin.columns(values)
     return {name: (columns[name][0], value) for name, value in values.items()}
-
-
-def _summary_statistics(run: Run) -> dict[str, tuple[str, float | None]]:
-    """``<statistic>[<pair>]`` -> (unit, value) for each contact pair and each force column of ``summary``."""
-    summary = run.tables.get("summary")
-    if summary is None:
-        return {}
-    units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in summary.schema}
-    stats = [name for name, unit in units.items() if unit == "N"]
-    out: dict[str, tuple[str, float | None]] = {}
-    for row in summary.select(["pair", *stats]).to_pylist():
-        for stat in stats:
-            out[f"{stat}[{row['pair']}]"] = ("N", row[stat])
-    return out
 
 
 def floor(unit: str) -> float | None:

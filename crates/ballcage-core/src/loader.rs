@@ -16,6 +16,7 @@ use crate::drillpipe::{self, DrillPipeSpec, Layout, PipeTables};
 use crate::error::SceneError;
 use crate::model::{Model, State};
 use crate::record::{Observer, TableDef, table_def};
+use crate::scene::provenance::{self, FieldOrigin, Proposal, Provenance};
 use crate::scene::{
     FieldDoc, FieldInfo, FieldUnits, Scene, TableKind, annotate, apply_override, describe,
     deserialize_with_path, lookup, merge, parse_toml,
@@ -43,13 +44,49 @@ impl Kind {
         }
     }
 
+    /// The kind whose `kind` key is `name` (`"generic"`, `"drill-pipe"`).
+    pub fn named(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|kind| kind.name() == name)
+    }
+
+    /// The unit and meaning of every field of a document of this kind.
+    pub fn field_docs(self) -> &'static [FieldDoc] {
+        match self {
+            Kind::Generic => Scene::FIELDS,
+            Kind::DrillPipe => DrillPipeSpec::FIELDS,
+        }
+    }
+
+    /// Where the defaults of a document of this kind come from: the lists
+    /// of [`FieldOrigin`]s that classify them, each with the kind whose
+    /// registry holds its PROPOSALs (the engine's sections, which every kind
+    /// shares, are the generic kind's).
+    pub fn provenance(self) -> [(Kind, &'static [FieldOrigin]); 2] {
+        let engine = (Kind::Generic, provenance::ENGINE);
+        match self {
+            Kind::Generic => [engine, (Kind::Generic, provenance::GENERIC)],
+            Kind::DrillPipe => [engine, (Kind::DrillPipe, drillpipe::PROVENANCE)],
+        }
+    }
+
+    /// The default document of this kind as a TOML value, every default
+    /// filled in: the paper's drill pipe, or for a generic scene the
+    /// smallest one ([`provenance::MINIMAL_GENERIC_SCENE`], one body).
+    pub fn default_value(self) -> Result<toml::Value, SceneError> {
+        let value = match self {
+            Kind::DrillPipe => toml::Value::try_from(DrillPipeSpec::default()),
+            Kind::Generic => toml::Value::try_from(Scene::from_toml_str(
+                provenance::MINIMAL_GENERIC_SCENE,
+                &[],
+            )?),
+        };
+        value.map_err(|e| SceneError::new("", "", format!("default {} scene: {e}", self.name())))
+    }
+
     /// The kind a document table declares (or implies, without `kind`).
     fn of(table: &toml::Table) -> Result<Self, SceneError> {
         match table.get("kind") {
-            Some(toml::Value::String(k)) => Self::ALL
-                .into_iter()
-                .find(|kind| kind.name() == k)
-                .ok_or_else(|| unknown_kind(k)),
+            Some(toml::Value::String(k)) => Self::named(k).ok_or_else(|| unknown_kind(k)),
             Some(other) => Err(unknown_kind(other)),
             None if !table.contains_key("bodies")
                 && ["pipe", "borehole", "drive"]
@@ -217,17 +254,40 @@ impl Document {
     /// law's fields in its own `units`, e.g. `# N/mm^2.2`), from the
     /// table of its kind's fields ([`Self::field`]). The text parses to the
     /// same values.
+    ///
+    /// Each field of the registry of unstated parameters ([`proposals`])
+    /// gets a comment line above it with its plausible range and source,
+    /// `# PROPOSAL, 17.5–21 mm: not in the paper`, when the document writes
+    /// it in the registry's unit (a contact law rewritten in other units or
+    /// as another law is not marked).
     pub fn to_toml_with_units(&self) -> String {
-        annotate(&self.to_toml(), self.field_docs(), &self.source_value())
+        // the tests keep the registry resolvable; were it not, the text would only lack its marks
+        let registry = registry(self.kind(), Lists::Applying).unwrap_or_default();
+        let mark = |key: &str, unit: &str| {
+            registry
+                .iter()
+                .find(|e| e.key == key && e.unit == unit)
+                .map(|e| e.proposal.mark(unit))
+        };
+        annotate(
+            &self.to_toml(),
+            self.field_docs(),
+            &self.source_value(),
+            &mark,
+        )
     }
 
     /// The unit and meaning of every field of the document's kind
     /// ([`Scene::FIELDS`], [`DrillPipeSpec::FIELDS`]).
     pub fn field_docs(&self) -> &'static [FieldDoc] {
-        match self.source {
-            Source::Generic => Scene::FIELDS,
-            Source::DrillPipe { .. } => DrillPipeSpec::FIELDS,
-        }
+        self.kind().field_docs()
+    }
+
+    /// Where the default of the field at a dotted key of the document's
+    /// kind comes from (the paper, a rule, a PROPOSAL, a setting); `None`
+    /// for a key no list classifies (a generic scene's bodies and pairs).
+    pub fn provenance(&self, key: &str) -> Option<&'static Provenance> {
+        provenance_of(self.kind(), key)
     }
 
     /// The unit and meaning of the field at a dotted key (`pipe.pitch`,
@@ -325,6 +385,107 @@ pub fn table(name: &str) -> Option<&'static TableDef> {
 /// The embedded default document: the paper's drill pipe.
 pub fn default_document() -> DrillPipeSpec {
     DrillPipeSpec::default()
+}
+
+/// Where the default at a dotted key of a document of `kind` comes from;
+/// `None` for a key no list of the kind classifies.
+pub fn provenance_of(kind: Kind, key: &str) -> Option<&'static Provenance> {
+    let lists = kind.provenance().map(|(_, list)| list);
+    provenance::origin_of(&lists, key).map(|o| &o.provenance)
+}
+
+/// One entry of the registry of unstated parameters, with what the
+/// registry does not hold itself: the default (from the kind's default
+/// document), the unit and the meaning (from its table of fields).
+#[derive(Debug, Clone)]
+pub struct ProposalEntry {
+    /// Dotted key, as `--set key=value` takes it.
+    pub key: &'static str,
+    /// The kind whose registry holds it; the generic kind's (the engine's
+    /// `simulation` section) apply to every kind.
+    pub kind: Kind,
+    /// The default, in `unit`.
+    pub default: f64,
+    /// The field's unit in the default document (`-` for a pure number).
+    pub unit: String,
+    /// One line on what the field is.
+    pub meaning: &'static str,
+    /// Source, reference, range (in `unit`) and why.
+    pub proposal: &'static Proposal,
+}
+
+/// The registry of unstated parameters: every PROPOSAL default of every
+/// kind (or of `kind` only), the drill pipe's first, each in its list's
+/// order. An error (a bug: the tests keep every key resolvable) names a
+/// key that is not a number of its kind's default document.
+pub fn proposals(kind: Option<Kind>) -> Result<Vec<ProposalEntry>, SceneError> {
+    let mut out = Vec::new();
+    for owner in [Kind::DrillPipe, Kind::Generic] {
+        if kind.is_none_or(|k| k == owner) {
+            out.extend(registry(owner, Lists::Own)?);
+        }
+    }
+    Ok(out)
+}
+
+/// Which of a kind's provenance lists [`registry`] reads.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Lists {
+    /// Those whose PROPOSALs the kind's registry holds.
+    Own,
+    /// Every list that classifies a document of the kind (the engine's too).
+    Applying,
+}
+
+/// The PROPOSALs of `kind`'s `lists`, resolved against its default document.
+fn registry(kind: Kind, lists: Lists) -> Result<Vec<ProposalEntry>, SceneError> {
+    let root = kind.default_value()?;
+    let mut out = Vec::new();
+    for (owner, list) in kind.provenance() {
+        if lists == Lists::Applying || owner == kind {
+            for origin in list.iter().filter(|o| o.proposal_entry().is_some()) {
+                out.push(entry(owner, kind, origin, &root)?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The registry entry of `origin` (a PROPOSAL of `owner`'s registry) with
+/// its default, unit and meaning from `root`, a default document of `kind`.
+fn entry(
+    owner: Kind,
+    kind: Kind,
+    origin: &'static FieldOrigin,
+    root: &toml::Value,
+) -> Result<ProposalEntry, SceneError> {
+    let key = origin.key;
+    let proposal = origin
+        .proposal_entry()
+        .ok_or_else(|| SceneError::new(key, "", "is not a PROPOSAL"))?;
+    let default = match lookup(root, key)? {
+        toml::Value::Float(x) => *x,
+        toml::Value::Integer(i) => *i as f64,
+        other => {
+            return Err(SceneError::new(
+                key,
+                other,
+                format!(
+                    "a PROPOSAL must be a number of the default {} document",
+                    kind.name()
+                ),
+            ));
+        }
+    };
+    let info = describe(kind.field_docs(), root, key)?;
+    Ok(ProposalEntry {
+        key,
+        kind: owner,
+        default,
+        unit: info.unit,
+        meaning: info.meaning,
+        proposal,
+    })
 }
 
 #[cfg(test)]

@@ -265,9 +265,12 @@ pub struct Model {
     pub threads: usize,
     /// Newton iterations of the `sdirk2` integrator.
     pub newton: crate::scene::NewtonSpec,
-    /// Tolerances (rtol [–], atol [m, rad, m/s, rad/s]) of adaptive steps;
-    /// `None`: fixed steps of `dt` ([`crate::scene::SimulationSpec::rtol`]).
-    pub tolerance: Option<(f64, f64)>,
+    /// Tolerances of adaptive steps; `None`: fixed steps of `dt`
+    /// ([`crate::scene::SimulationSpec::rtol`]).
+    pub tolerance: Option<crate::scene::Tolerance>,
+    /// Largest adaptive step [s] ([`crate::scene::SimulationSpec::max_step`],
+    /// default the output interval).
+    pub max_step: f64,
     /// Largest energy the integrator may create, as a fraction of the
     /// energy scale ([`crate::scene::DivergenceSpec::energy_growth`]).
     pub energy_growth: f64,

@@ -379,9 +379,15 @@ impl Simulation {
                 format!("{:e}", e.velocity_error),
             ),
         ];
-        if let Some((rtol, atol)) = self.model.tolerance {
-            out.push(("ballcage.rtol", format!("{rtol:e}")));
-            out.push(("ballcage.atol", format!("{atol:e}")));
+        if let Some(tol) = self.model.tolerance {
+            out.push(("ballcage.rtol", format!("{:e}", tol.rtol)));
+            out.push(("ballcage.atol_position_m", format!("{:e}", tol.position)));
+            out.push(("ballcage.atol_rotation_rad", format!("{:e}", tol.rotation)));
+            out.push(("ballcage.atol_velocity_m_s", format!("{:e}", tol.velocity)));
+            out.push((
+                "ballcage.atol_angular_velocity_rad_s",
+                format!("{:e}", tol.angular_velocity),
+            ));
         }
         out.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
     }

@@ -12,12 +12,17 @@ use ballcage_core::Simulation;
 /// moving up at 0.05 m/s: z(t) = z_s + (v₀/ω_d)·e^(−ζω₀t)·sin(ω_d·t),
 /// ω_d = ω₀·√(1 − ζ²) (as tests/sdirk2.rs). `extra`: more `[simulation]` keys.
 fn oscillator(dt: f64, extra: &str) -> Simulation {
+    oscillator_framed(dt, 0.1, extra)
+}
+
+/// [`oscillator`] with frames every `output_interval` [s].
+fn oscillator_framed(dt: f64, output_interval: f64, extra: &str) -> Simulation {
     common::sim(&format!(
         r#"
         [simulation]
         duration = 0.1
         dt = {dt}
-        output_interval = 0.1
+        output_interval = {output_interval}
         integrator = "esdirk32"
         newton = {{ tolerance = 1e-13 }}
         {extra}
@@ -43,14 +48,20 @@ fn oscillator(dt: f64, extra: &str) -> Simulation {
     ))
 }
 
+/// The oscillator's exact height [m] and vertical velocity [m/s] at `t` [s].
+fn oscillator_exact(t: f64) -> (f64, f64) {
+    let (w0, zeta) = (100.0, 0.1);
+    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
+    let decay = (-zeta * w0 * t).exp();
+    let z = 0.05 - 9.81e-4 + 0.05 / wd * decay * (wd * t).sin();
+    let v = 0.05 / wd * decay * (wd * (wd * t).cos() - zeta * w0 * (wd * t).sin());
+    (z, v)
+}
+
 /// |z(T) − exact| [m] of a finished oscillator run.
 fn oscillator_error(sim: &Simulation) -> f64 {
     let i = common::body(sim, "ball");
-    let t = sim.time();
-    let (w0, zeta) = (100.0, 0.1);
-    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
-    let exact = 0.05 - 9.81e-4 + 0.05 / wd * (-zeta * w0 * t).exp() * (wd * t).sin();
-    (sim.state().pos[i].z - exact).abs()
+    (sim.state().pos[i].z - oscillator_exact(sim.time()).0).abs()
 }
 
 /// log2 of successive error ratios (the step halves each time).
@@ -216,13 +227,16 @@ fn the_embedded_estimate_is_second_order() {
 
 #[test]
 fn adaptive_error_follows_the_tolerance() {
-    // dt = 0.01 s is only the largest step (ω₀·dt = 1); the controller
+    // max_step = 0.01 s is the largest step (ω₀·h = 1); the controller
     // picks the steps. Ten times tighter tolerances cut the error about
     // tenfold (steps ∝ tol^(1/3), a third-order error ∝ tol).
     let mut errors = vec![];
     let mut steps = vec![];
     for rtol in [1e-4, 1e-5, 1e-6] {
-        let mut sim = oscillator(0.01, &format!("rtol = {rtol}\natol = {}", rtol * 1e-2));
+        let mut sim = oscillator(
+            0.01,
+            &format!("rtol = {rtol}\natol = {}\nmax_step = 0.01", rtol * 1e-2),
+        );
         sim.run().unwrap();
         assert!((sim.time() - 0.1).abs() < 1e-15, "landed at {}", sim.time());
         let e = sim.error_stats().expect("esdirk32 has an estimate");
@@ -244,8 +258,60 @@ fn adaptive_error_follows_the_tolerance() {
 }
 
 #[test]
+fn frames_within_adaptive_steps_are_interpolated_to_third_order() {
+    // Steps of max_step = 2 ms (a tolerance loose enough never to ask for
+    // less), frames every 1 ms: the even frames are step ends, the odd ones
+    // the middle of a step, interpolated (cubic Hermite). The interpolant
+    // adds at most h⁴/384·max|x⁗| to the error of the step ends around it
+    // on positions and h⁴/384·max|v⁗| on velocities (x⁗ ≤ A·ω₀⁴, v⁗ ≤
+    // A·ω₀⁵, amplitude A = v₀/ω_d ≈ 5e-4 m); straight lines between the
+    // ends would add h²/8·A·ω₀², three orders of magnitude more.
+    let mut sim = oscillator_framed(0.01, 1e-3, "rtol = 0.1\nmax_step = 2e-3");
+    let i = common::body(&sim, "ball");
+    let mut errors = vec![(0.0f64, 0.0f64)];
+    while !sim.is_done() {
+        sim.step().unwrap();
+        let (z, v) = oscillator_exact(sim.time());
+        errors.push((
+            (sim.state().pos[i].z - z).abs(),
+            (sim.state().vel[i].z - v).abs(),
+        ));
+    }
+    let e = sim.error_stats().expect("esdirk32 has an estimate");
+    assert_eq!(
+        (e.accepted, e.rejected),
+        (50, 0),
+        "steps of 2 ms only (smallest {})",
+        e.smallest_step
+    );
+    let (h, a, w0) = (2e-3f64, 5e-4, 100.0f64);
+    let bound_z = h.powi(4) / 384.0 * a * w0.powi(4);
+    let bound_v = bound_z * w0;
+    let linear_z = h * h / 8.0 * a * w0 * w0;
+    let mut excess = (0.0f64, 0.0f64);
+    for k in (1..errors.len() - 1).step_by(2) {
+        let ends = (
+            errors[k - 1].0.max(errors[k + 1].0),
+            errors[k - 1].1.max(errors[k + 1].1),
+        );
+        excess.0 = excess.0.max(errors[k].0 - ends.0);
+        excess.1 = excess.1.max(errors[k].1 - ends.1);
+    }
+    let largest = errors.iter().fold(0.0f64, |m, e| m.max(e.0));
+    eprintln!(
+        "largest frame error {largest:.2e} m; the middle frames exceed their step ends by \
+         {:.2e} m, {:.2e} m/s; Hermite bounds {bound_z:.2e} m, {bound_v:.2e} m/s; \
+         straight lines {linear_z:.2e} m",
+        excess.0, excess.1
+    );
+    assert!(excess.0 < bound_z, "{excess:?}");
+    assert!(excess.1 < bound_v, "{excess:?}");
+    assert!(linear_z > 100.0 * bound_z);
+}
+
+#[test]
 fn the_run_metadata_counts_the_steps_and_the_estimate() {
-    let mut sim = oscillator(0.01, "rtol = 1e-5");
+    let mut sim = oscillator(0.01, "rtol = 1e-5\nmax_step = 0.01");
     sim.run().unwrap();
     let e = sim.error_stats().expect("esdirk32 has an estimate");
     let meta: std::collections::HashMap<String, String> =
@@ -264,7 +330,42 @@ fn the_run_metadata_counts_the_steps_and_the_estimate() {
     assert!(number("ballcage.error_estimate_velocity_m_s") > 0.0);
     assert!(meta["ballcage.error_estimate"].ends_with("m/s"));
     assert_eq!(number("ballcage.rtol"), 1e-5);
-    assert_eq!(number("ballcage.atol"), 1e-5, "atol defaults to rtol");
+    for key in [
+        "ballcage.atol_position_m",
+        "ballcage.atol_rotation_rad",
+        "ballcage.atol_velocity_m_s",
+        "ballcage.atol_angular_velocity_rad_s",
+    ] {
+        assert_eq!(number(key), 1e-5, "{key}: atol defaults to rtol");
+    }
+}
+
+#[test]
+fn each_quantity_has_its_own_absolute_tolerance() {
+    // The oscillator's velocity (≤ 0.05 m/s) is held by atol + rtol·|v|:
+    // with rtol = 1e-6 its atol decides. A velocity atol 1000 times looser
+    // than the position's lets the steps grow (the position error, ~1e-7
+    // of the 0.05 m height, then sets them), the other way round does not.
+    let run = |extra: &str| {
+        let mut sim = oscillator(0.01, &format!("rtol = 1e-6\n{extra}"));
+        sim.run().unwrap();
+        let accepted = sim
+            .error_stats()
+            .expect("esdirk32 has an estimate")
+            .accepted;
+        let meta: std::collections::HashMap<String, String> =
+            sim.finish().metadata.into_iter().collect();
+        (accepted, meta)
+    };
+    let (tight, _) = run("atol = 1e-8");
+    let (loose_v, meta) = run("atol = 1e-8\natol_velocity = 1e-5");
+    let (loose_w, _) = run("atol = 1e-8\natol_angular_velocity = 1e-5\natol_rotation = 1e-5");
+    eprintln!("steps: all 1e-8 {tight}, velocity 1e-5 {loose_v}, rotations 1e-5 {loose_w}");
+    assert!(loose_v * 3 < tight * 2, "{loose_v} vs {tight}");
+    // The ball does not turn: its rotation tolerances change nothing.
+    assert_eq!(loose_w, tight);
+    assert_eq!(meta["ballcage.atol_velocity_m_s"], "1e-5");
+    assert_eq!(meta["ballcage.atol_position_m"], "1e-8");
 }
 
 #[test]

@@ -376,14 +376,15 @@ fn a_hardness_below_1_mpa_and_a_wear_coefficient_above_1_are_refused() {
 
 #[test]
 fn the_adaptive_steps_settings_are_checked_by_name() {
-    // The paper scene is adaptive (rtol 1e-4): a largest step must be positive and divide the
-    // output interval; rtol = 0 gives fixed steps, with which max_step and atol have no meaning.
+    // The paper scene is adaptive (rtol 1e-4): a largest step must be positive (it need not
+    // divide the output interval: frames within a step are interpolated); rtol = 0 gives fixed
+    // steps, with which max_step and atol have no meaning, and dt must divide the interval.
     let e = pipe_error_of(&["simulation.max_step=-1"]);
     assert_eq!(e.path, "simulation.max_step");
     assert!(e.reason.contains("positive"), "{}", e.reason);
-    let e = pipe_error_of(&["simulation.max_step=3e-4"]);
+    let e = pipe_error_of(&["simulation.rtol=0", "simulation.dt=3e-4"]);
     assert_eq!(e.path, "simulation.output_interval");
-    assert!(e.reason.contains("simulation.max_step"), "{}", e.reason);
+    assert!(e.reason.contains("simulation.dt"), "{}", e.reason);
     for key in ["simulation.max_step=1e-3", "simulation.atol=1e-6"] {
         let e = pipe_error_of(&["simulation.rtol=0", key]);
         assert_eq!(e.path, key.split('=').next().unwrap());
@@ -398,10 +399,13 @@ fn the_adaptive_steps_settings_are_checked_by_name() {
     let e = pipe_error_of(&["simulation.integrator=\"sdirk2\""]);
     assert_eq!(e.path, "simulation.rtol");
     assert!(e.reason.contains("set simulation.rtol = 0"), "{}", e.reason);
-    // Fixed steps of dt with rtol = 0 load, and so does a largest step of half the interval.
+    // Fixed steps of dt with rtol = 0 load, and so do largest steps that do or do not divide
+    // the interval.
     for ok in [
         &["simulation.integrator=\"sdirk2\"", "simulation.rtol=0"][..],
         &["simulation.max_step=5e-4"][..],
+        &["simulation.max_step=3e-4"][..],
+        &["simulation.max_step=2.5e-3"][..],
     ] {
         let overrides: Vec<String> = ok.iter().map(|s| s.to_string()).collect();
         let doc =

@@ -536,6 +536,50 @@ fn default_scene_toml() -> String {
     loader::default_document().to_toml()
 }
 
+/// The registry of unstated parameters (PROPOSAL values): one dict per
+/// entry, `ballcage.proposals()`'s rows; `kind` keeps one scene kind's.
+#[pyfunction]
+#[pyo3(signature = (kind = None))]
+fn proposals<'py>(py: Python<'py>, kind: Option<&str>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    let kind = kind
+        .map(|name| {
+            Kind::named(name).ok_or_else(|| {
+                let kinds: Vec<String> = Kind::ALL
+                    .iter()
+                    .map(|k| format!("{:?}", k.name()))
+                    .collect();
+                input_err(
+                    py,
+                    format!(
+                        "kind = {name:?}: unknown scene kind (kinds: {})",
+                        kinds.join(", ")
+                    ),
+                )
+            })
+        })
+        .transpose()?;
+    let entries = guard("proposals", || loader::proposals(kind))
+        .map_err(|m| internal_err(py, m))?
+        .map_err(|e| internal_err(py, format!("the registry of PROPOSAL values: {e} (a bug)")))?;
+    entries
+        .into_iter()
+        .map(|e| {
+            let row = PyDict::new(py);
+            row.set_item("key", e.key)?;
+            row.set_item("scene_kind", e.kind.name())?;
+            row.set_item("default", e.default)?;
+            row.set_item("low", e.proposal.low)?;
+            row.set_item("high", e.proposal.high)?;
+            row.set_item("unit", e.unit)?;
+            row.set_item("source", e.proposal.source.name())?;
+            row.set_item("reference", e.proposal.reference)?;
+            row.set_item("meaning", e.meaning)?;
+            row.set_item("range_reason", e.proposal.range_reason)?;
+            Ok(row)
+        })
+        .collect()
+}
+
 /// The Arrow schema of an output table of any scene kind.
 #[pyfunction]
 fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
@@ -625,6 +669,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(table_schema, m)?)?;
     m.add_function(wrap_pyfunction!(default_scene_toml, m)?)?;
+    m.add_function(wrap_pyfunction!(proposals, m)?)?;
     m.add_function(wrap_pyfunction!(integrator_facts, m)?)?;
     m.add_function(wrap_pyfunction!(whole_multiple, m)?)?;
     m.add_function(wrap_pyfunction!(longest_link, m)?)?;

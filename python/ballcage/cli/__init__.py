@@ -13,6 +13,7 @@ lists them); each parses its options and calls the library:
     size         joint sizing by the paper's eq. (9), in mm (`size`)
     sweep        a grid or list of scene variants, in parallel, one summary row per case (`sweep`)
     chart        the design chart over curvature radius x joint length (`chart`)
+    sensitivity  how much each unstated parameter moves each quantity: table, ranking, tornado charts (`sensitivity`)
     view         the chain turning in 3D: an HTML page, a GIF or an MP4 of a run (`view`)
 
 `_common` holds what they share: `UsageError`, the parser class, the option
@@ -21,7 +22,7 @@ adders and checks, and the loading of the command line's scene.
 Exit codes: 0 success; 1 the run diverged (`SimulationError`; ``ballcage run``
 then still writes what was recorded, marked incomplete), the verification run
 of ``ballcage run --verify`` failed (the run's own tables written), a study
-failed, or a sweep case or chart cell did not finish; 2 bad input (an invalid scene, a TOML
+failed, or a sweep case, chart cell or sensitivity run did not finish; 2 bad input (an invalid scene, a TOML
 syntax error, a missing file, a malformed ``--set``, an unknown ``--tables``
 name, an ``--out`` folder holding another run, an option value the library
 refused, a usage error); 3 the output could not be written; 70 internal error
@@ -38,13 +39,26 @@ import sys
 from collections.abc import Sequence
 
 from ballcage import _native
-from ballcage.cli import accuracy, buckling, chart, paper, run, scene, schema, size, stability, sweep, view
+from ballcage.cli import (
+    accuracy,
+    buckling,
+    chart,
+    paper,
+    run,
+    scene,
+    schema,
+    sensitivity,
+    size,
+    stability,
+    sweep,
+    view,
+)
 from ballcage.cli._common import PROG, Parser, UsageError, fail
 
 __all__ = ["build_parser", "main"]
 
 #: The command modules, in the order ``ballcage --help`` lists them.
-COMMANDS = (run, paper, accuracy, stability, scene, schema, buckling, size, sweep, chart, view)
+COMMANDS = (run, paper, accuracy, stability, scene, schema, buckling, size, sweep, chart, sensitivity, view)
 #: Exit code of an internal error (a bug in ballcage): sysexits' EX_SOFTWARE.
 EXIT_INTERNAL = 70
 #: Options whose value may be a (wrong) negative number, which argparse would take for an option.

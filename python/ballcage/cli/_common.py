@@ -90,6 +90,28 @@ def positive(option: str, text: str | None, what: str = "a positive time in seco
     return value
 
 
+def add_case_timeout_option(parser: argparse.ArgumentParser, default: str) -> None:
+    parser.add_argument(
+        "--case-timeout", metavar="SECONDS",
+        help="wall time each case's run may take: a case past it is stopped, recorded as timed-out with its frames "
+        f"up to then, and run again when the command is run again; 0: no limit ({default})",
+    )  # fmt: skip
+
+
+def case_timeout(text: str | None) -> float | None:
+    """``--case-timeout``: seconds, 0 for no limit (returned as 0.0); ``None`` when the option was not given."""
+    if text is None:
+        return None
+    what = "a positive number of seconds, or 0 for no limit"
+    try:
+        value = float(text)
+    except ValueError:
+        raise UsageError(f"--case-timeout {text!r}: not a number; give {what}") from None
+    if not (math.isfinite(value) and value >= 0):
+        raise UsageError(f"--case-timeout {text}: must be {what}")
+    return value
+
+
 def count(option: str, text: str, least: int) -> int:
     """`text` as a whole number, at least `least`."""
     try:

@@ -43,12 +43,18 @@ def add(commands: Commands) -> None:
     paper.add_argument(
         "--scheduler", metavar="ADDRESS", help="with --sweeps: run the sweep on the Dask cluster at ADDRESS; needs ballcage[dask]"
     )
+    paper.add_argument(
+        "--sensitivity", metavar="PATH", type=Path,
+        help="a sensitivity.parquet of ballcage sensitivity (default: DIR/sensitivity.parquet when it exists): every "
+        "comparison row gains the range of its quantity over the unstated parameters and the dominant parameter",
+    )  # fmt: skip
     add_quiet_option(paper, "no progress bar and no summary")
     paper.set_defaults(command=command)
 
 
 def command(args: argparse.Namespace) -> int:
     from ballcage.paper import run_paper  # deferred: imports matplotlib
+    from ballcage.paper.running import find_sensitivity
 
     from ballcage.studies.sweep_run import scheduler_client
     from ballcage.studies.sweep_spec import SweepError
@@ -57,11 +63,15 @@ def command(args: argparse.Namespace) -> int:
     out = checked_out(args.out)
     if (args.workers or args.scheduler) and not args.sweeps:
         raise UsageError(f"--{'workers' if args.workers else 'scheduler'}: only with --sweeps (it sets where the sweep runs)")
+    if args.sensitivity is not None and not args.sensitivity.is_file():
+        raise UsageError(f"--sensitivity {args.sensitivity}: no such file (give the sensitivity.parquet of ballcage "
+                         "sensitivity)")
+    study = find_sensitivity(out, args.sensitivity)
     try:
         with scheduler_client(args.scheduler) as client:
             paths = run_paper(
                 out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None, workers=args.workers,
-                client=client,
+                client=client, sensitivity=args.sensitivity,
             )
     except _native.SceneError as e:
         raise UsageError(f"{DEFAULT_SCENE_NAME}: {e}") from e
@@ -70,6 +80,8 @@ def command(args: argparse.Namespace) -> int:
     if not args.quiet:
         for name, path in paths.items():
             print(_summary(name, path))
+        if study is not None:
+            print(f"ballcage: the comparison shows the spread over the unstated parameters of {study}")
         note = _fallback_note(paths)
         if note is not None:
             print(f"ballcage: warning: {note}")

@@ -1,4 +1,4 @@
-"""``ballcage scene show``: a scene as TOML with every default and each number's unit (`Scene.to_toml`)."""
+"""``ballcage scene show``: a scene as TOML, every default with its unit and each PROPOSAL's range (`Scene.to_toml`)."""
 
 from __future__ import annotations
 
@@ -21,7 +21,9 @@ def add(commands: Commands) -> None:
         description=(
             "Print a scene as TOML (without SCENE.toml, the embedded paper scene), every default written out "
             "and each number's unit as a comment at the end of its line (contact laws in their own units, "
-            "e.g. N/mm^2.2): copy it, edit it, run it."
+            "e.g. N/mm^2.2); each value the paper does not give (a PROPOSAL) under a comment line with its "
+            "plausible range and source, e.g. '# PROPOSAL, 17.5–21 mm: not in the paper' "
+            "(ballcage.proposals() has the registry, docs/proposals.md): copy it, edit it, run it."
         ),
     )
     show.add_argument("scene", metavar="SCENE.toml", nargs="?", help="scene file (TOML); default: the embedded one")

@@ -5,7 +5,18 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ballcage.cli._common import Commands, UsageError, add_out_option, add_quiet_option, workers
+from ballcage.cli._common import (
+    Commands,
+    UsageError,
+    add_case_timeout_option,
+    add_out_option,
+    add_quiet_option,
+    case_timeout,
+    workers,
+)
+
+#: Options whose value may be a (wrong) negative number (`ballcage.cli` lets the option's check report it).
+NUMBER_OPTIONS = ("--case-timeout",)
 
 
 def add(commands: Commands) -> None:
@@ -27,6 +38,7 @@ def add(commands: Commands) -> None:
         "--scheduler", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS (tcp://host:8786); needs ballcage[dask]"
     )
     sweep.add_argument("--retry-failed", action="store_true", help="also run again the cases that diverged or failed")
+    add_case_timeout_option(sweep, "default: none, a sweep having no estimate of its cases' time")
     sweep.add_argument("--no-plots", action="store_true", help="do not draw DIR/plots/*.png")
     add_quiet_option(sweep, "no progress and no summary lines")
     sweep.set_defaults(command=command)
@@ -36,13 +48,14 @@ def command(args: argparse.Namespace) -> int:
     """Runs the sweep, prints what it wrote; 0 when every case is ok, 1 when some are not, 2 for a bad sweep file."""
     from ballcage.studies.sweep_spec import SweepError  # deferred: pyarrow, numpy, matplotlib
 
+    limit = case_timeout(args.case_timeout)
     try:
-        return _sweep(args)
+        return _sweep(args, limit)
     except SweepError as e:
         raise UsageError(str(e)) from e
 
 
-def _sweep(args: argparse.Namespace) -> int:
+def _sweep(args: argparse.Namespace, limit: float | None) -> int:
     from ballcage.studies.sweep_run import describe, scheduler_client, sweep
 
     try:
@@ -55,6 +68,7 @@ def _sweep(args: argparse.Namespace) -> int:
                 retry_failed=args.retry_failed,
                 plots=not args.no_plots,
                 progress=False if args.quiet else None,
+                case_timeout=limit,
             )
     except KeyboardInterrupt:
         print(f"ballcage: sweep interrupted; run the same command again to resume from {args.out}", file=sys.stderr)

@@ -7,7 +7,7 @@ import math
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyarrow as pa
@@ -41,7 +41,20 @@ from ballcage.measures.shape import BendRanking
 from ballcage.paper.places import distribution_row, key_place_text, link12_text
 from ballcage.run import Run
 
-__all__ = ["COMPARISON_SCHEMA", "PHASES_KEY", "PhaseListing", "comparison", "fmt", "phase_listing"]
+if TYPE_CHECKING:
+    from ballcage.studies.sensitivity_report import Spread
+
+__all__ = [
+    "COMPARISON_SCHEMA",
+    "PHASES_KEY",
+    "SPREAD_FIELDS",
+    "PhaseListing",
+    "comparison",
+    "fmt",
+    "phase_listing",
+    "sensitivity_quantity",
+    "with_spread",
+]
 
 COMPARISON_SCHEMA = pa.schema(
     [
@@ -61,6 +74,18 @@ PHASES_KEY = "ballcage.phases"
 INDEX_KEYS = frozenset({"most_deformed_joint"})
 #: A sweep row's key: ``sweep_<variant>_<what>_n``.
 _SWEEP_KEY = re.compile(r"^sweep_(?P<variant>[A-Za-z0-9]+)_(?P<what>tube_mean_max|key_peak)_n$")
+#: A per-joint tube row's key (the paper's joint NN is our link NN): ``tube_normal_peak_joint10_n``.
+_JOINT_KEY = re.compile(r"^tube_(?P<kind>normal|tangential)_(?P<stat>mean|peak)_joint(?P<link>\d+)_n$")
+#: The columns `with_spread` adds, in the row's unit: name -> (Arrow type, description).
+SPREAD_FIELDS: dict[str, tuple[pa.DataType, str]] = {
+    "spread_min": (pa.float64(), "smallest value of the quantity over the sensitivity study's runs (the unstated "
+                   "parameters over their ranges; unit as unit); null when the study has no such quantity"),
+    "spread_max": (pa.float64(), "largest value over the sensitivity study's runs; null as spread_min"),
+    "spread_dominant": (pa.string(), "the parameter with the largest effect on the quantity in the sensitivity study; "
+                        "null when none moves it or the study has no such quantity"),
+    "spread_dominant_below_error": (pa.bool_(), "the dominant parameter's effect is below the study's numerical "
+                                    "error; null without an estimate"),
+}  # fmt: skip
 
 
 @dataclass
@@ -384,3 +409,47 @@ def _sweep_value(run: Run, variant: str, what: str) -> _Value:
     race = {"inner_normal": "head race", "outer_normal": "seat race"}.get(peak.column, "")
     where = f"; at hinge {peak.ids[0]:02d} key {peak.ids[1]} ({race}), t = {peak.t:.4g} s" if peak.ids else ""
     return _Value(peak.value, f"{definition}{where}")
+
+
+def sensitivity_quantity(key: str) -> str | None:
+    """The quantity of a sensitivity study (`ballcage.studies.sensitivity_run`) that comparison row `key` is.
+
+    The same name (the comparison and the sweep plug-in share their
+    quantities), except the paper's per-joint tube forces, which are our
+    per-link ones (``tube_normal_peak_joint10_n`` → ``tube_normal_peak_link_10_n``);
+    ``None`` for a section-4 row (``sweep_*``), a value of another scene
+    than the one the study varies.
+    """
+    if _SWEEP_KEY.match(key):
+        return None
+    m = _JOINT_KEY.match(key)
+    if m is not None:
+        return f"tube_{m['kind']}_{m['stat']}_link_{int(m['link']):02d}_n"
+    return key
+
+
+def with_spread(table: pa.Table, spreads: Mapping[str, Spread], meta: Mapping[str, str]) -> pa.Table:
+    """The comparison `table` with the spread of a sensitivity study: `SPREAD_FIELDS`, null where no quantity matches.
+
+    A row matches the study's quantity `sensitivity_quantity` names when their
+    units agree (``""``, ``"1"`` and ``"-"`` all mean a pure number). `meta`
+    (the study's source and settings) goes into the schema metadata.
+    """
+    columns: dict[str, list[Any]] = {name: [] for name in SPREAD_FIELDS}
+    for row in table.select(["key", "unit"]).to_pylist():
+        name = sensitivity_quantity(row["key"])
+        spread = spreads.get(name) if name is not None else None
+        if spread is not None and _plain_unit(spread.unit) != _plain_unit(row["unit"] or ""):
+            spread = None
+        columns["spread_min"].append(spread.low if spread is not None else None)
+        columns["spread_max"].append(spread.high if spread is not None else None)
+        columns["spread_dominant"].append(spread.dominant if spread is not None else None)
+        columns["spread_dominant_below_error"].append(spread.below_error if spread is not None and spread.dominant else None)
+    for name, (kind, description) in SPREAD_FIELDS.items():
+        field = pa.field(name, kind, metadata={"description": description, "unit": "see unit" if kind == pa.float64() else ""})
+        table = table.append_column(field, pa.array(columns[name], type=kind))
+    return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+
+
+def _plain_unit(unit: str) -> str:
+    return "" if unit in ("", "1", "-") else unit

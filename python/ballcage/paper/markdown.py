@@ -51,10 +51,13 @@ def comparison_markdown(
             "see docs/model.md §6): compare those as order of magnitude only. Empty cells were not computed. "
             + (f"Section-4 cases with reference values: {swept}." if swept else "Sweep rows need `--sweeps`.")
         ),
-        "",
-        "| key | paper | ours | unit | ratio | note |",
-        "| --- | ---: | ---: | --- | ---: | --- |",
     ]
+    spread = "spread_min" in table.column_names
+    if spread:
+        lines += ["", _spread_paragraph(table)]
+    extra = ("spread over unstated parameters | dominant parameter | ", "--- | --- | ") if spread else ("", "")
+    header = f"| key | paper | ours | unit | ratio | {extra[0]}note |"
+    lines += ["", header, f"| --- | ---: | ---: | --- | ---: | {extra[1]}--- |"]
     phases = json.loads((table.schema.metadata or {}).get(PHASES_KEY.encode(), b"{}"))
     for r in table.to_pylist():
         paper = "" if r["paper"] is None else fmt(r["paper"])
@@ -64,11 +67,10 @@ def comparison_markdown(
         if phases.get("note"):
             note = note.replace(phases["note"], "phases: listed under the table")
         note = note.replace("|", "\\|")
-        lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {note} |")
+        cells = _spread_cells(r) if spread else ""
+        lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {cells}{note} |")
     if run is not None and run.fallback_note is not None:
-        lines[lines.index("| key | paper | ours | unit | ratio | note |")] = (
-            f"**Warning: {run.fallback_note}.**\n\n| key | paper | ours | unit | ratio | note |"
-        )
+        lines[lines.index(header)] = f"**Warning: {run.fallback_note}.**\n\n{header}"
     lines += _phase_lines(phases)
     if run is not None:
         lines += place_lines(run)
@@ -79,6 +81,43 @@ def comparison_markdown(
 
         lines += trend_markdown(*section4)
     return "\n".join(lines) + "\n"
+
+
+def _spread_cells(row: Mapping[str, Any]) -> str:
+    """A row's spread cells: ``min – max | parameter |``, ``— | — |`` where the study has no such quantity."""
+    if row["spread_min"] is None and row["spread_dominant"] is None:
+        return "— | — | "
+    span = "—" if row["spread_min"] is None else f"{fmt(row['spread_min'], 5)} – {fmt(row['spread_max'], 5)}"
+    dominant = f"`{row['spread_dominant']}`" if row["spread_dominant"] else "none moves it"
+    if row["spread_dominant_below_error"]:
+        dominant += " (below the numerical error)"
+    return f"{span} | {dominant} | "
+
+
+def _spread_paragraph(table: pa.Table) -> str:
+    """Where the spread columns come from: the sensitivity study, its method, runs and command."""
+    meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
+    matched = [r for r in table.to_pylist() if r["spread_min"] is not None]
+    differ = [
+        r["key"] for r in matched
+        if r["ours"] is not None and r["spread_min"] is not None
+        and not (r["spread_min"] - 1e-9 * abs(r["spread_min"]) <= r["ours"] <= r["spread_max"] + 1e-9 * abs(r["spread_max"]))
+    ]  # fmt: skip
+    text = (
+        f"Spread over the unstated parameters: from `{meta.get('ballcage.sensitivity.source', '')}` "
+        f"({meta.get('ballcage.sensitivity.method', '')}, {meta.get('ballcage.sensitivity.runs', '')} runs of "
+        f"{meta.get('ballcage.sensitivity.duration_s', '')} s, {meta.get('ballcage.sensitivity.date', '')}: "
+        f"`{meta.get('ballcage.sensitivity.command', '')}`): the smallest and largest value of the quantity over the "
+        "study's runs and the parameter with the largest effect (its sensitivity.md ranks them all). "
+        "— where the study has no such quantity (the section-4 rows are other scenes than the one it varies). "
+    )
+    if differ:
+        text += (
+            f"This run's value lies outside the study's range in {len(differ)} of {len(matched)} rows "
+            f"({', '.join(differ[:4])}{', …' if len(differ) > 4 else ''}): the study ran another scene than this run "
+            f"(its overrides: {meta.get('ballcage.sensitivity.overrides', '')})."
+        )
+    return text
 
 
 def duty_lines(run: Run) -> list[str]:

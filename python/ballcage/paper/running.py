@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 from ballcage import _native
 from ballcage._files import write_parquet, write_text
 from ballcage.duty import write_loss_figure
-from ballcage.paper.compare import comparison
+from ballcage.paper.compare import comparison, with_spread
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.run import simulate
@@ -23,9 +23,10 @@ if TYPE_CHECKING:
     import pyarrow as pa
 
     from ballcage.paper.section4 import Section4
+    from ballcage.studies.sensitivity_report import Spread
     from ballcage.studies.sweep_spec import SweepSpec
 
-__all__ = ["PAPER_TABLES", "paper_scene", "run_paper"]
+__all__ = ["PAPER_TABLES", "SENSITIVITY_FILE", "find_sensitivity", "paper_scene", "run_paper"]
 
 #: The 3D view `run_paper` writes beside the figures (`ballcage view`), and its most frames (evenly spaced).
 VIEW_FILE, VIEW_FRAMES = "chain.html", 120
@@ -33,6 +34,8 @@ VIEW_FILE, VIEW_FRAMES = "chain.html", 120
 PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive", "wear")
 #: The loss breakdown `run_paper` writes beside the figures (`ballcage.duty.write_loss_figure`).
 LOSS_FILE = "losses.png"
+#: A sensitivity study's table (``ballcage sensitivity --out DIR``) that `run_paper` looks for in its folder.
+SENSITIVITY_FILE = "sensitivity.parquet"
 
 
 def run_paper(
@@ -43,6 +46,7 @@ def run_paper(
     *,
     workers: int | None = None,
     client: Any = None,
+    sensitivity: str | os.PathLike[str] | None = None,
 ) -> dict[str, Path]:
     """Runs the paper scene and writes tables, figures and the comparison into `out_dir`.
 
@@ -64,8 +68,15 @@ def run_paper(
     the friction loss by contact, `ballcage.duty`), ``"view"`` (``chain.html``,
     the chain turning in 3D, `ballcage.view`), ``"comparison"``,
     ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder),
-    ``"fig16_curvature"``, ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``. Raises
-    `ballcage.SceneError` for an invalid override and `ballcage.SimulationError`
+    ``"fig16_curvature"``, ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``.
+
+    With a sensitivity study (`sensitivity`, the path of its ``sensitivity.parquet``;
+    default ``out_dir/sensitivity.parquet`` when it exists, `find_sensitivity`),
+    every comparison row gains the range of its quantity over the study's runs
+    and the parameter with the largest effect (`ballcage.paper.compare.with_spread`;
+    null, "—" in ``comparison.md``, where the study has no such quantity). Raises
+    `ballcage.SceneError` for an invalid override, `ballcage.InputError` for a
+    sensitivity table that cannot be read, and `ballcage.SimulationError`
     when the main run diverges (a sweep case that diverges is recorded in the
     sweep's summary and its rows stay empty).
     """
@@ -73,6 +84,8 @@ def run_paper(
 
     user = override_list(overrides)
     out = Path(out_dir)
+    study = find_sensitivity(out, sensitivity)
+    spread = _read_spread(study) if study is not None else None  # before the run: a bad file fails at once
     main_scene = paper_scene(user)
     spec = section4_spec(user) if sweeps else None
     if spec is not None:
@@ -85,10 +98,12 @@ def run_paper(
     section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
     sweep_runs = section4[0].variant_runs() if section4 is not None else None
     table = comparison(run, sweep_runs)
+    if spread is not None:
+        table = with_spread(table, *spread)
     written["comparison"] = write_parquet(table, out / "comparison.parquet")
     md = comparison_markdown(
         table,
-        command=_command_line(out, user, sweeps),
+        command=_command_line(out, user, sweeps, sensitivity),
         run=run,
         sweep_runs=sweep_runs,
         section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
@@ -115,6 +130,29 @@ def _run_section4(
     return section4, trends
 
 
+def find_sensitivity(out: Path, given: str | os.PathLike[str] | None) -> Path | None:
+    """The sensitivity table for the comparison: `given` (which must exist), else ``out/sensitivity.parquet`` if any."""
+    if given is not None:
+        path = Path(given)
+        if not path.is_file():
+            raise _native.InputError(f"sensitivity = {str(path)!r}: no such file (a sensitivity.parquet of "
+                                     "ballcage sensitivity)")
+        return path
+    path = out / SENSITIVITY_FILE
+    return path if path.is_file() else None
+
+
+def _read_spread(path: Path) -> tuple[dict[str, Spread], dict[str, str]]:
+    """The spreads of the sensitivity table at `path` and the metadata the comparison keeps of it."""
+    from ballcage.studies.common import study_meta
+    from ballcage.studies.sensitivity_report import read_sensitivity, spreads
+
+    table = read_sensitivity(path)
+    meta = {k: v for k, v in study_meta(table).items() if k.startswith("ballcage.sensitivity.")}
+    meta["ballcage.sensitivity.source"] = str(path)
+    return spreads(table), meta
+
+
 def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     """The paper's scene as `run_paper` runs it: the default scene recording `PAPER_TABLES`, then `overrides`.
 
@@ -133,10 +171,12 @@ def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     return scene
 
 
-def _command_line(out: Path, overrides: Sequence[str], sweeps: bool) -> str:
+def _command_line(out: Path, overrides: Sequence[str], sweeps: bool, sensitivity: str | os.PathLike[str] | None) -> str:
     args = ["ballcage", "paper", "--out", str(out)]
     for o in overrides:
         args += ["--set", o]
     if sweeps:
         args.append("--sweeps")
+    if sensitivity is not None:
+        args += ["--sensitivity", os.fspath(sensitivity)]
     return shlex.join(args)

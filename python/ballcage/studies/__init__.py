@@ -58,7 +58,13 @@ cases), `sweep_case` (one case on a worker: run, files, record),
 `sweep_plots` and `sweep_run` (`sweep`: local threads or Dask, resume,
 progress); the design chart (``ballcage chart``): `design_chart_grid` (the
 cells and their feasibility), `design_chart` (the sweep of the feasible ones,
-``design_chart.parquet``) and `design_chart_plot` (its figure).
+``design_chart.parquet``) and `design_chart_plot` (its figure); the sensitivity
+study (``ballcage sensitivity``): `sensitivity_parameters` (the ranges: the registry
+of unstated parameters or given), `sensitivity_quantities` (what each run measures),
+`sensitivity_run` (`sensitivity`: the runs as one sweep, the table),
+`sensitivity_report` (``sensitivity.md``; a table read back as spreads) and
+`sensitivity_plot` (the tornado charts); `refinement` (the tighter setting of a
+verification run, shared with ``ballcage run --verify``).
 """
 
 from ballcage.studies.accuracy_report import accuracy_markdown, write_accuracy
@@ -67,7 +73,8 @@ from ballcage.studies.common import StudyError, available_integrators
 from ballcage.studies.design_chart import DesignChart, design_chart
 from ballcage.studies.ladders import default_steps
 from ballcage.studies.scalars import FLOORS, MAX_QUANTITY, Quantity, quantities
-from ballcage.studies.schemas import ACCURACY_SCHEMA, STABILITY_SCHEMA
+from ballcage.studies.schemas import ACCURACY_SCHEMA, SENSITIVITY_SCHEMA, STABILITY_SCHEMA
+from ballcage.studies.sensitivity_run import Sensitivity, sensitivity
 from ballcage.studies.stability_parameters import (
     PARAMETER_NAMES,
     Parameter,
@@ -86,9 +93,11 @@ __all__ = [
     "FLOORS",
     "MAX_QUANTITY",
     "PARAMETER_NAMES",
+    "SENSITIVITY_SCHEMA",
     "STABILITY_SCHEMA",
     "Parameter",
     "Quantity",
+    "Sensitivity",
     "StudyError",
     "SweepError",
     "SweepResult",
@@ -102,6 +111,7 @@ __all__ = [
     "drill_pipe_parameters",
     "probe_scene",
     "quantities",
+    "sensitivity",
     "stability",
     "stability_markdown",
     "sweep",

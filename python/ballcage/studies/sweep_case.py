@@ -9,8 +9,9 @@ engine cost, and the quantities of the task's plug-in,
 `ballcage.studies.sweep_quantities.SweepQuantities`). Every file is written to a
 temporary name and renamed, so a file under its final name is complete, and a
 case with a record is finished. A run that diverges keeps what it recorded up
-to then (status ``diverged``); any other failure is status ``error``; neither
-is raised.
+to then (status ``diverged``); so does a run stopped at the case's time limit
+(``CaseTask.timeout``, ``--case-timeout``: status ``timed-out``); any other
+failure is status ``error``; none is raised.
 """
 
 from __future__ import annotations
@@ -25,16 +26,20 @@ from typing import Any
 
 from ballcage import _native
 from ballcage._files import write_parquet, write_text
-from ballcage.run import Run, simulate
+from ballcage.run import Run, TimeLimitError, simulate
 from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
-from ballcage.studies.sweep_spec import partition_name
+from ballcage.studies.sweep_spec import partition_name, toml_value
 
-__all__ = ["CaseTask", "read_case_run", "read_record", "record_path", "run_case", "scene_path", "write_record"]
+__all__ = [
+    "TIMED_OUT", "CaseTask", "read_case_run", "read_record", "record_path", "run_case", "scene_path", "write_record",
+]
 
 #: Name of every table file inside a case's partition directory.
 PART = "part.parquet"
 #: Folder of the per-case records and scenes.
 CASES = "cases"
+#: The status of a case stopped at its time limit (`CaseTask.timeout`); such a case is run again on resume.
+TIMED_OUT = "timed-out"
 
 
 @dataclass(frozen=True)
@@ -51,6 +56,7 @@ class CaseTask:
     parameters: tuple[str, ...]  # every swept key of the sweep, for the resolved values
     out: str  # the sweep's output folder
     quantities: SweepQuantities = GENERIC  # what the record's "quantities" hold (pickled with the task)
+    timeout: float | None = None  # s of wall time the case's run may take (--case-timeout); None: no limit
 
 
 def record_path(out: Path, partition: str) -> Path:
@@ -70,9 +76,11 @@ def run_case(task: CaseTask) -> dict[str, Any]:
     run: Run | None = None
     status, error = "ok", None
     try:
-        run = simulate(scene, progress=False)
+        run = simulate(scene, progress=False, time_limit=task.timeout)
     except _native.SimulationError as e:
         run, status, error = getattr(e, "run", None), "diverged", str(e)
+    except TimeLimitError as e:
+        run, status, error = e.run, TIMED_OUT, _timed_out(task, e)
     except Exception as e:  # noqa: BLE001 - a failing case is recorded, never raised
         status, error = "error", _describe(e)
     record = _base_record(task, scene, status, error)
@@ -185,6 +193,15 @@ def _clean(value: Any) -> Any:
     if isinstance(value, (list, tuple)):
         return [_clean(v) for v in value]
     return value
+
+
+def _timed_out(task: CaseTask, error: TimeLimitError) -> str:
+    """The message of a case stopped at its time limit: the case, the limit, where it stopped, how to raise it."""
+    values = " ".join(f"{k}={toml_value(v)}" for k, v in task.values.items()) or "no swept values"
+    return (
+        f"case {task.case_id} ({values}) timed out: {error}; raise the limit with --case-timeout SECONDS "
+        "(case_timeout= in Python; 0 for none) and run the same command again, which runs timed-out cases again"
+    )
 
 
 def _describe(error: BaseException) -> str:

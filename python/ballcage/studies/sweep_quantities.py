@@ -7,6 +7,9 @@ and meaning in the field's metadata. Nothing here knows a scene kind's
 quantities:
 
 - `GENERIC` (scenes of bodies): no quantity columns;
+- `SUMMARY_STATISTICS` (scenes of bodies): the summary statistics of each
+  contact pair (`summary_statistics`), the headline quantities of a generic
+  scene for ``ballcage run --verify`` and ``ballcage sensitivity``;
 - `ballcage.measures.DRILL_PIPE` (drill pipes): included angles, ranges of
   motion, tube, cage and key forces, drive efficiency, per-link tube forces;
   ``ballcage sweep``, ``ballcage chart`` and ``ballcage paper --sweeps`` pass it.
@@ -16,6 +19,7 @@ quantities:
 
 from __future__ import annotations
 
+import re
 from collections.abc import Collection
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
@@ -25,7 +29,15 @@ if TYPE_CHECKING:
     from ballcage import _native
     from ballcage.run import Run
 
-__all__ = ["GENERIC", "GenericQuantities", "SweepQuantities", "for_scene"]
+__all__ = [
+    "GENERIC",
+    "SUMMARY_STATISTICS",
+    "GenericQuantities",
+    "SummaryStatistics",
+    "SweepQuantities",
+    "for_scene",
+    "summary_statistics",
+]
 
 
 @runtime_checkable
@@ -59,6 +71,49 @@ class GenericQuantities:
 
 
 GENERIC = GenericQuantities()
+
+#: The name of a generic scene's summary statistic: ``<column of the summary table>[<contact pair>]``.
+_STATISTIC = re.compile(r"(?P<column>[A-Za-z0-9_]+)\[(?P<pair>.*)\]")
+
+
+def summary_statistics(run: Run) -> dict[str, tuple[str, float | None]]:
+    """``<statistic>[<pair>]`` -> (unit, value) for each contact pair and each force column of ``summary``.
+
+    The force columns are those in N (peak, mean, RMS of the normal and
+    tangential force over ``record.summary_window``); empty without a
+    ``summary`` table.
+    """
+    summary = run.tables.get("summary")
+    if summary is None:
+        return {}
+    units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in summary.schema}
+    stats = [name for name, unit in units.items() if unit == "N"]
+    out: dict[str, tuple[str, float | None]] = {}
+    for row in summary.select(["pair", *stats]).to_pylist():
+        for stat in stats:
+            out[f"{stat}[{row['pair']}]"] = ("N", row[stat])
+    return out
+
+
+class SummaryStatistics:
+    """A plug-in of scenes of bodies: each contact pair's summary statistics (`summary_statistics`), in N."""
+
+    def columns(self, recorded: Collection[str]) -> dict[str, tuple[str, str]]:
+        out: dict[str, tuple[str, str]] = {}
+        for name in sorted(recorded):
+            m = _STATISTIC.fullmatch(name)
+            if m is not None:
+                out[name] = ("N", f"summary.{m['column']} of contact pair {m['pair']} (over record.summary_window)")
+        return out
+
+    def __call__(self, run: Run) -> dict[str, float | None]:
+        return {name: value for name, (_, value) in summary_statistics(run).items()}
+
+    def __repr__(self) -> str:
+        return "ballcage.studies.sweep_quantities.SUMMARY_STATISTICS"
+
+
+SUMMARY_STATISTICS = SummaryStatistics()
 
 
 def for_scene(scene: _native.Scene) -> SweepQuantities:

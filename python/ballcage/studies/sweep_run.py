@@ -14,13 +14,15 @@ by default the one of the base scene's kind (`for_scene`).
 
 Running the same sweep into the same folder again resumes: a case with a
 record whose hash matches and whose table files exist is skipped (with
-``retry_failed``, only if it finished ``ok``). A record of another sweep's
-case (another hash) is refused, naming the case.
+``retry_failed``, only if it finished ``ok``); a case that timed out
+(``case_timeout``, status ``timed-out``) is run again. A record of another
+sweep's case (another hash) is refused, naming the case.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import sys
 import time
@@ -36,13 +38,21 @@ import pyarrow as pa
 from ballcage import _native
 from ballcage._files import write_parquet
 from ballcage.run import _isatty
-from ballcage.studies.sweep_case import CaseTask, failed_record, read_record, run_case, table_path, write_record
+from ballcage.studies.sweep_case import (
+    TIMED_OUT,
+    CaseTask,
+    failed_record,
+    read_record,
+    run_case,
+    table_path,
+    write_record,
+)
 from ballcage.studies.sweep_plots import write_plots
 from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities, for_scene
 from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
-__all__ = ["SweepResult", "connect", "pending_cases", "scheduler_client", "sweep"]
+__all__ = ["SweepResult", "checked_case_timeout", "connect", "pending_cases", "scheduler_client", "sweep"]
 
 
 @dataclass
@@ -67,6 +77,7 @@ def sweep(
     plots: bool = True,
     progress: bool | None = None,
     quantities: SweepQuantities | None = None,
+    case_timeout: float | None = None,
 ) -> SweepResult:
     """Runs every case of a sweep file (path, dict or `SweepSpec`) into the folder `out`.
 
@@ -80,10 +91,16 @@ def sweep(
     per case otherwise, ``False`` silent. `quantities`: what each case's
     record and the summary's quantity columns hold (a `SweepQuantities`
     plug-in; ``None``: `for_scene` of the base scene, so the drill pipe's
-    quantities for a drill pipe and none for a scene of bodies). Raises
-    `SweepError` for a bad sweep file or a folder holding another sweep,
-    before anything runs.
+    quantities for a drill pipe and none for a scene of bodies).
+    `case_timeout`: wall time [s] each case's run may take (``--case-timeout``;
+    ``None`` or 0: no limit, the default, since a sweep has no estimate of
+    its cases' time before they run): a case past it is stopped between two of
+    its run's 200 pieces and recorded as ``timed-out`` with its frames up to
+    then, and the others go on; resuming runs it again. Raises `SweepError`
+    for a bad sweep file, a folder holding another sweep or a bad
+    `case_timeout`, before anything runs.
     """
+    timeout = checked_case_timeout(case_timeout)
     loaded = load_sweep(spec)
     cases = loaded.check()
     folder = Path(out)
@@ -91,12 +108,13 @@ def sweep(
         raise SweepError(f"--out {folder}: exists and is not a directory")
     base = _native.Scene.from_toml(loaded.base_toml)
     plugin = quantities if quantities is not None else for_scene(base)
-    tasks = [_task(loaded, c, folder, plugin) for c in cases]
+    tasks = [_task(loaded, c, folder, plugin, timeout) for c in cases]
     pending, done = _split_finished(tasks, folder, retry_failed)
     say = _Say(progress is not False)
     where = _where(client, workers)
+    limit = f", each stopped past {timeout:g} s of wall time (--case-timeout)" if timeout is not None else ""
     say(f"sweep {loaded.name}: {len(tasks)} cases; {len(done)} already finished in {folder} (skipped), "
-        f"running {len(pending)} {where}")
+        f"running {len(pending)} {where}{limit}")
     folder.mkdir(parents=True, exist_ok=True)
     bar = SweepProgress(len(pending), enabled=progress is not False)
     try:
@@ -114,7 +132,27 @@ def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
     return len(pending)
 
 
-def _task(spec: SweepSpec, case: Case, out: Path, quantities: SweepQuantities = GENERIC) -> CaseTask:
+def checked_case_timeout(value: float | str | None) -> float | None:
+    """A case time limit [s] as `sweep` takes it: ``None`` (and 0) for none, else a positive finite number.
+
+    Raises `SweepError` naming the value.
+    """
+    if value is None:
+        return None
+    try:
+        seconds = float(value)
+    except (TypeError, ValueError):
+        raise SweepError(f"case_timeout = {value!r}: not a number of seconds (None or 0: no limit)") from None
+    if seconds == 0.0:
+        return None
+    if not (math.isfinite(seconds) and seconds > 0):
+        raise SweepError(f"case_timeout = {value!r}: must be a positive number of seconds (None or 0: no limit)")
+    return seconds
+
+
+def _task(
+    spec: SweepSpec, case: Case, out: Path, quantities: SweepQuantities = GENERIC, timeout: float | None = None
+) -> CaseTask:
     return CaseTask(
         index=case.index,
         case_id=case.case_id,
@@ -126,11 +164,12 @@ def _task(spec: SweepSpec, case: Case, out: Path, quantities: SweepQuantities = 
         parameters=tuple(spec.parameters),
         out=str(out.resolve()),
         quantities=quantities,
+        timeout=timeout,
     )
 
 
 def _split_finished(tasks: list[CaseTask], out: Path, retry_failed: bool) -> tuple[list[CaseTask], list[dict[str, Any]]]:
-    """The cases still to run, and the records of those finished (their files all present)."""
+    """The cases still to run, and the records of those finished (their files all present; not timed out)."""
     pending, done = [], []
     for task in tasks:
         record = read_record(out, task.partition)
@@ -143,7 +182,8 @@ def _split_finished(tasks: list[CaseTask], out: Path, retry_failed: bool) -> tup
                 f"this sweep's is {task.case_id}): choose another --out folder or remove that one"
             )
         files = all(table_path(out, t, task.partition).is_file() for t in record.get("tables", []))
-        if not files or (retry_failed and record.get("status") != "ok"):
+        status = record.get("status")
+        if not files or status == TIMED_OUT or (retry_failed and status != "ok"):
             pending.append(task)
         else:
             done.append(record)

@@ -20,7 +20,8 @@ _HEAD: tuple[tuple[str, pa.DataType, str, str], ...] = (
     ("case", pa.int32(), "", "case index in the sweep (the hive partition key case=NNNN of the table datasets)"),
     ("case_id", pa.string(), "", "index and the start of the hash of the case's base scene and overrides"),
     ("status", pa.string(), "", "ok: ran to the end; diverged: SimulationError (tables hold the frames up to then); "
-     "error: any other failure"),
+     "timed-out: stopped at the case time limit, --case-timeout (tables hold the frames up to then; run again on "
+     "resume); error: any other failure"),
     ("error", pa.string(), "", "why the case did not finish (the error message); null when ok"),
 )
 COST_COLUMNS: tuple[tuple[str, pa.DataType, str, str], ...] = (

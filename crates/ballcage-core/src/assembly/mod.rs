@@ -57,11 +57,11 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         integrator: scene.simulation.integrator,
         dt: scene.simulation.step(),
         newton: scene.simulation.newton.clone(),
-        tolerance: scene
+        tolerance: scene.simulation.tolerance(),
+        max_step: scene
             .simulation
-            .rtol
-            .filter(|_| scene.simulation.adaptive())
-            .map(|rtol| (rtol, scene.simulation.atol.unwrap_or(rtol))),
+            .max_step
+            .unwrap_or(scene.simulation.output_interval),
         threads: match scene.simulation.threads {
             0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
             n => n as usize,

@@ -12,6 +12,7 @@
 //! | module | job |
 //! |---|---|
 //! | `spec` | the document: sections, defaults, validation |
+//! | `provenance` | where each default comes from: the paper, a rule, a PROPOSAL (range and why) |
 //! | `expand` | document → scene + layout, one function per part |
 //! | `names` | the one place part names are formatted |
 //! | `layout` | body and pair ids of the parts |
@@ -29,6 +30,7 @@ mod expand;
 mod ids;
 mod layout;
 pub mod names;
+mod provenance;
 pub mod sizing;
 mod spec;
 pub mod stress;
@@ -37,6 +39,7 @@ pub mod wear;
 
 pub use expand::Expansion;
 pub use layout::{BodyPart, Feature, HingeLayout, KeyLayout, Layout, PairPart, Part};
+pub use provenance::PROVENANCE;
 pub use spec::{
     BallKeySpec, BoreholeSpec, DrillPipeSpec, DriveSpec, GravitySpec, HingeModel, IdealCvSpec,
     KIND, LowerEnd, MaterialSpec, MaterialsSpec, PipeRecordSpec, PipeSpec, PipeTable,

@@ -1,7 +1,9 @@
 //! The drill-pipe scene document: engineering parameters with the paper's
 //! defaults, and their validation. Units are SI (lengths in m, masses in kg)
 //! except where a field name says `_deg` or `_rpm`; contact laws keep the
-//! paper's N-mm-s field units, converted once on assembly.
+//! paper's N-mm-s field units, converted once on assembly. Where each
+//! default comes from (the paper, a rule, or a PROPOSAL with its plausible
+//! range) is listed once, by dotted key, in `provenance.rs`.
 
 use serde::{Deserialize, Serialize};
 
@@ -121,8 +123,9 @@ pub struct BallKeySpec {
     /// mouth does (checked).
     pub cage_length: f64,
     /// Distance from the hinge centre to the seat's mouth, toward the head
-    /// [m]. 20 mm: the head (104 mm) and seat (136 mm) overlap by 40 mm in
-    /// the 200 mm pitch, centred on the hinge (docs/model.md §3). The mouth
+    /// [m]. PROPOSAL (a reading of Table 1): 20 mm, the head (104 mm) and
+    /// seat (136 mm) overlapping by 40 mm in the 200 mm pitch, read as
+    /// centred on the hinge (docs/model.md §3). The mouth
     /// is the seat's sphere cut there: radius √(seat_radius² − offset²).
     pub mouth_offset: f64,
 }
@@ -233,7 +236,8 @@ pub struct PipeSpec {
     pub pitch: f64,
     /// Link outer diameter for tube contact [m]. Paper (Table 1): 0.086.
     pub link_diameter: f64,
-    /// Link mass [kg]: 86/30 × 200 mm steel envelope.
+    /// Link mass [kg]. PROPOSAL (a reading: the paper gives no mass): the
+    /// 86/30 × 200 mm steel envelope.
     pub link_mass: f64,
     /// Link principal inertia, axial then transverse [kg·m²].
     pub link_inertia: [f64; 3],
@@ -248,7 +252,8 @@ pub struct PipeSpec {
     /// Sample points along each link (rims included) that bracket the
     /// extrema of its depth in the tube (or, with `"patches"`, locate its
     /// contact patches); the force does not depend on this count once each
-    /// extremum has a bracket of its own. PROPOSAL: 33 (6.25 mm apart). On
+    /// extremum has a bracket of its own. Default 33 (6.25 mm apart), a
+    /// numerical setting, not a PROPOSAL. On
     /// the paper run (SDIRK2 at 100 µs for every count) the compared
     /// quantities at 5 samples agree with those at 17 within 0.08 % (link
     /// 10's peak tube force within 1.2 %), and at 17 with those at 33 within
@@ -462,7 +467,9 @@ impl Default for ResistingMomentSpec {
     }
 }
 
-/// A contact material: normal law and friction.
+/// A contact material: normal law and friction. The paper's (§2.3 eqs.
+/// (6)–(7)); its stiffness K is a PROPOSAL (a reading: the paper prints
+/// 1e5 N/mm, with n = 2.2 Adams' default 1e5 N/mm^2.2; docs/model.md §1.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
@@ -768,13 +775,14 @@ pub struct DrillPipeSpec {
 /// The `kind` of a drill-pipe scene document.
 pub const KIND: &str = "drill-pipe";
 
-/// `simulation.rtol` of the paper's scene: ESDIRK3(2)'s adaptive steps (up
-/// to the 1 ms output interval) at this tolerance keep every compared
-/// quantity within 0.034 % of a reference two integrators agree on, at 1.8
-/// times the speed of SDIRK2 at 100 µs, itself 0.16 % off
-/// (docs/accuracy.md, `scripts/work_precision.py`). `simulation.dt` stays
-/// the 100 µs fixed step a fixed-step integrator takes with
-/// `simulation.rtol = 0`.
+/// `simulation.rtol` of the paper's scene: ESDIRK3(2)'s adaptive steps (the
+/// frames between them interpolated) at this tolerance keep every compared
+/// quantity within 0.06 % of a reference two integrators agree on over the
+/// 1.8 s and within 0.2 % over the first 0.6 s (3e-4 would keep 0.11 % and
+/// 1.2 %: a peak tube force of the ramp misses the 1 %), at about three
+/// times the speed of SDIRK2 at 100 µs (docs/accuracy.md,
+/// `scripts/work_precision.py`). `simulation.dt` stays the 100 µs fixed step
+/// a fixed-step integrator takes with `simulation.rtol = 0`.
 pub const DEFAULT_RTOL: f64 = 1e-4;
 
 impl DrillPipeSpec {
@@ -861,6 +869,10 @@ impl Default for DrillPipeSpec {
                 max_steps: crate::scene::default_max_steps(),
                 rtol: Some(DEFAULT_RTOL),
                 atol: None,
+                atol_position: None,
+                atol_rotation: None,
+                atol_velocity: None,
+                atol_angular_velocity: None,
                 max_step: None,
             },
             world: GravitySpec::default(),

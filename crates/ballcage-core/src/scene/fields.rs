@@ -224,8 +224,15 @@ pub fn describe(
 /// numbers, and a comment line `# key: unset, meaning [unit]` at the end of
 /// each table for each of its optional fields (`Fields::Optional`) the
 /// document leaves out; `root` is the parsed document and `docs` its
-/// fields. The text parses to the same values.
-pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> String {
+/// fields. A line that sets a number is preceded by the comment line
+/// `# <mark>` when `mark(dotted key, unit)` gives one (a PROPOSAL's range
+/// and source, [`super::Proposal::mark`]). The text parses to the same values.
+pub fn annotate(
+    text: &str,
+    docs: &'static [FieldDoc],
+    root: &toml::Value,
+    mark: &dyn Fn(&str, &str) -> Option<String>,
+) -> String {
     let mut section = String::new();
     // Elements seen so far of each array of tables (`[[bodies]]`), by its dotted name.
     let mut seen: std::collections::HashMap<String, usize> = Default::default();
@@ -234,8 +241,8 @@ pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> St
         if line.starts_with('[') {
             unset_fields(&mut out, docs, root, &section);
         }
-        out.push_str(line);
         if let Some(header) = line.strip_prefix('[') {
+            out.push_str(line);
             let name = header.trim_matches(|c| c == '[' || c == ']');
             if header.starts_with('[') {
                 *seen.entry(name.to_string()).or_default() += 1;
@@ -255,10 +262,18 @@ pub fn annotate(text: &str, docs: &'static [FieldDoc], root: &toml::Value) -> St
                 .and_then(|_| describe(docs, root, &full).ok())
                 .map(|info| info.unit)
                 .filter(|u| !u.is_empty());
+            if let Some(comment) = unit.as_deref().and_then(|u| mark(&full, u)) {
+                out.push_str("# ");
+                out.push_str(&comment);
+                out.push('\n');
+            }
+            out.push_str(line);
             if let Some(unit) = unit {
                 out.push_str("  # ");
                 out.push_str(&unit);
             }
+        } else {
+            out.push_str(line);
         }
         out.push('\n');
     }

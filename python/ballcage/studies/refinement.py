@@ -1,0 +1,64 @@
+"""The setting of a verification run: a scene's error bound ten times tighter (`tighter`).
+
+``ballcage run --verify`` (`ballcage.verify.verify`) reruns a scene at this
+setting and takes the difference of its headline quantities as the run's
+measured error; ``ballcage sensitivity`` (`ballcage.studies.sensitivity_run`)
+runs its base case at this setting as one case of its sweep, for the
+numerical-error bar of its tornado charts. One rule, here, for both.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ballcage import _native
+
+__all__ = ["TIGHTER", "Tighter", "tighter"]
+
+#: A run's error bound falls by this factor in the verification run.
+TIGHTER = 10
+#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' fixed-step integrators,
+#: not ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
+_OPT_IN_ORDERS = {"esdirk32": 3}
+
+
+@dataclass(frozen=True)
+class Tighter:
+    """The verification run's setting: its `label` (``"dt/4"``, ``"rtol/10"``) and the `overrides` that make it."""
+
+    label: str
+    overrides: tuple[str, ...]
+
+
+#: The absolute tolerances of ``[simulation]``: ``atol`` and one per quantity.
+ATOL_KEYS = ("atol", "atol_position", "atol_rotation", "atol_velocity", "atol_angular_velocity")
+
+
+def tighter(scene: _native.Scene) -> Tighter:
+    """The verification run's setting: the scene's error bound ten times tighter.
+
+    - Adaptive steps (a positive ``simulation.rtol``; ESDIRK3(2)): ``rtol/10``,
+      and each absolute tolerance the scene sets (``simulation.atol`` and the
+      per-quantity ``atol_*``) over 10 (unset, they follow rtol). ``max_step``, the largest step, is kept.
+    - Fixed steps: ``dt/d`` with d = ceil(10^(1/p)), p the integrator's order
+      (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
+      dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
+      by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
+      step, so the frames are the same.
+
+    Every other field (the Newton tolerance, ``max_steps``) is kept: a
+    ``max_steps`` the d times more steps exceed makes the verification fail.
+    """
+    simulation = scene.value("simulation")
+    rtol = simulation.get("rtol")
+    if rtol:
+        overrides = [f"simulation.rtol={rtol / TIGHTER!r}"]
+        for key in ATOL_KEYS:
+            if simulation.get(key) is not None:
+                overrides.append(f"simulation.{key}={simulation[key] / TIGHTER!r}")
+        return Tighter(f"rtol/{TIGHTER}", tuple(overrides))
+    name = simulation["integrator"]
+    order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
+    d = math.ceil(TIGHTER ** (1.0 / order))
+    return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
