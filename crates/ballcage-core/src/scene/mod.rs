@@ -350,9 +350,10 @@ pub struct SimulationSpec {
     pub max_step: Option<f64>,
     /// Absolute tolerance of the adaptive steps [SI unit of each quantity]:
     /// one number, read as metres for positions, radians for rotations, m/s
-    /// for velocities and rad/s for angular velocities. Default: `rtol`
-    /// (errors of quantities near zero held to rtol·1 m, 1 rad, 1 m/s,
-    /// 1 rad/s). Only with `rtol`.
+    /// for velocities and rad/s for angular velocities, the default of the
+    /// four per-quantity tolerances below. Default: `rtol` (errors of
+    /// quantities near zero held to rtol·1 m, 1 rad, 1 m/s, 1 rad/s). Only
+    /// with `rtol`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub atol: Option<f64>,
     /// Absolute tolerance of the adaptive steps on positions [m]. Default:
