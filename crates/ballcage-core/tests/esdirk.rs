@@ -6,56 +6,21 @@
 mod common;
 
 use ballcage_core::Simulation;
+use common::oscillator_exact;
 
-/// A 1 kg ball on a linear spring-dashpot contact (k = 1e4 N/m, c = 20
-/// N·s/m: ω₀ = 100 rad/s, ζ = 0.1) under gravity, starting at its rest depth
-/// moving up at 0.05 m/s: z(t) = z_s + (v₀/ω_d)·e^(−ζω₀t)·sin(ω_d·t),
-/// ω_d = ω₀·√(1 − ζ²) (as tests/sdirk2.rs). `extra`: more `[simulation]` keys.
+/// The oscillator of tests/common with `esdirk32` at steps of `dt` (the
+/// Newton iterations to 1e-13), one frame at the end. `extra`: more
+/// `[simulation]` keys.
 fn oscillator(dt: f64, extra: &str) -> Simulation {
     oscillator_framed(dt, 0.1, extra)
 }
 
 /// [`oscillator`] with frames every `output_interval` [s].
 fn oscillator_framed(dt: f64, output_interval: f64, extra: &str) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.1
-        dt = {dt}
-        output_interval = {output_interval}
-        integrator = "esdirk32"
-        newton = {{ tolerance = 1e-13 }}
-        {extra}
-        [world]
-        gravity = [0.0, 0.0, -9.81]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = 0.05 }}
-        mass = 1.0
-        position = [0.0, 0.0, {z0}]
-        velocity = [0.0, 0.0, 0.05]
-        [[contacts]]
-        bodies = ["floor", "ball"]
-        normal = {{ law = "linear", stiffness = 1e4, damping = 20.0 }}
-        "#,
-        z0 = 0.05 - 9.81e-4,
+    common::oscillator(&format!(
+        "dt = {dt}\noutput_interval = {output_interval}\nintegrator = \"esdirk32\"\n\
+         newton = {{ tolerance = 1e-13 }}\n{extra}"
     ))
-}
-
-/// The oscillator's exact height [m] and vertical velocity [m/s] at `t` [s].
-fn oscillator_exact(t: f64) -> (f64, f64) {
-    let (w0, zeta) = (100.0, 0.1);
-    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
-    let decay = (-zeta * w0 * t).exp();
-    let z = 0.05 - 9.81e-4 + 0.05 / wd * decay * (wd * t).sin();
-    let v = 0.05 / wd * decay * (wd * (wd * t).cos() - zeta * w0 * (wd * t).sin());
-    (z, v)
 }
 
 /// |z(T) − exact| [m] of a finished oscillator run.
@@ -86,26 +51,9 @@ fn third_order_on_the_damped_oscillator() {
     }
 }
 
-/// A tumbling asymmetric box without forces: the gyroscopic term alone
-/// turns the rotation axis (as tests/sdirk2.rs).
+/// The tumbling box of tests/common, Newton to 1e-14.
 fn tumbling(integrator: &str, dt: f64) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.4
-        dt = {dt}
-        output_interval = 0.4
-        integrator = "{integrator}"
-        newton = {{ tolerance = 1e-14 }}
-        [record]
-        tables = []
-        [[bodies]]
-        name = "box"
-        shape = {{ type = "cuboid", half_extents = [0.1, 0.05, 0.02] }}
-        mass = 1.0
-        angular_velocity = [0.5, 4.0, 0.2]
-        "#
-    ))
+    common::tumbling(integrator, dt, 1e-14)
 }
 
 #[test]

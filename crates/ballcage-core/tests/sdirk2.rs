@@ -105,37 +105,10 @@ fn stiffness_jacobian_matches_finite_differences() {
     );
 }
 
-/// A 1 kg ball on a linear spring-dashpot contact (k = 1e4 N/m, c = 20
-/// N·s/m: ω₀ = 100 rad/s, ζ = 0.1) under gravity, starting at its rest depth
-/// moving up at 0.05 m/s: it rings down about rest, never leaving the floor,
-/// z(t) = z_s + (v₀/ω_d)·e^(−ζω₀t)·sin(ω_d·t), ω_d = ω₀·√(1 − ζ²).
+/// The oscillator of tests/common at steps of `dt` with `integrator`.
 fn oscillator(integrator: &str, dt: f64) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.1
-        dt = {dt}
-        output_interval = 0.1
-        integrator = "{integrator}"
-        [world]
-        gravity = [0.0, 0.0, -9.81]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = 0.05 }}
-        mass = 1.0
-        position = [0.0, 0.0, {z0}]
-        velocity = [0.0, 0.0, 0.05]
-        [[contacts]]
-        bodies = ["floor", "ball"]
-        normal = {{ law = "linear", stiffness = 1e4, damping = 20.0 }}
-        "#,
-        z0 = 0.05 - 9.81e-4,
+    common::oscillator(&format!(
+        "dt = {dt}\noutput_interval = 0.1\nintegrator = \"{integrator}\""
     ))
 }
 
@@ -144,11 +117,7 @@ fn oscillator_error(integrator: &str, dt: f64) -> f64 {
     let mut sim = oscillator(integrator, dt);
     sim.run().unwrap();
     let i = common::body(&sim, "ball");
-    let t = sim.time();
-    let (w0, zeta) = (100.0, 0.1);
-    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
-    let exact = 0.05 - 9.81e-4 + 0.05 / wd * (-zeta * w0 * t).exp() * (wd * t).sin();
-    (sim.state().pos[i].z - exact).abs()
+    (sim.state().pos[i].z - common::oscillator_exact(sim.time()).0).abs()
 }
 
 #[test]
@@ -172,25 +141,9 @@ fn sdirk2_is_second_order_and_linearly_implicit_euler_first() {
     }
 }
 
-/// A tumbling asymmetric box without forces (the gyroscopic term alone).
+/// The tumbling box of tests/common, Newton to 1e-13.
 fn tumbling(integrator: &str, dt: f64) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.4
-        dt = {dt}
-        output_interval = 0.4
-        integrator = "{integrator}"
-        newton = {{ tolerance = 1e-13 }}
-        [record]
-        tables = []
-        [[bodies]]
-        name = "box"
-        shape = {{ type = "cuboid", half_extents = [0.1, 0.05, 0.02] }}
-        mass = 1.0
-        angular_velocity = [0.5, 4.0, 0.2]
-        "#
-    ))
+    common::tumbling(integrator, dt, 1e-13)
 }
 
 #[test]

@@ -93,3 +93,70 @@ pub fn incline_scene(
         "#
     )
 }
+
+/// A 1 kg ball on a linear spring-dashpot contact (k = 1e4 N/m, c = 20
+/// N·s/m: ω₀ = 100 rad/s, ζ = 0.1) under gravity, starting at its rest depth
+/// moving up at 0.05 m/s: it rings down about rest, never leaving the floor
+/// ([`oscillator_exact`]). `simulation`: the `[simulation]` keys besides
+/// the duration (0.1 s).
+pub fn oscillator(simulation: &str) -> Simulation {
+    sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.1
+        {simulation}
+        [world]
+        gravity = [0.0, 0.0, -9.81]
+        [record]
+        tables = []
+        [[bodies]]
+        name = "floor"
+        motion = "fixed"
+        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
+        [[bodies]]
+        name = "ball"
+        shape = {{ type = "ball", radius = 0.05 }}
+        mass = 1.0
+        position = [0.0, 0.0, {z0}]
+        velocity = [0.0, 0.0, 0.05]
+        [[contacts]]
+        bodies = ["floor", "ball"]
+        normal = {{ law = "linear", stiffness = 1e4, damping = 20.0 }}
+        "#,
+        z0 = 0.05 - 9.81e-4,
+    ))
+}
+
+/// The [`oscillator`]'s exact height [m] and vertical velocity [m/s] at `t`
+/// [s]: z(t) = z_s + (v₀/ω_d)·e^(−ζω₀t)·sin(ω_d·t), ω_d = ω₀·√(1 − ζ²).
+pub fn oscillator_exact(t: f64) -> (f64, f64) {
+    let (w0, zeta) = (100.0, 0.1);
+    let wd = w0 * (1.0f64 - zeta * zeta).sqrt();
+    let decay = (-zeta * w0 * t).exp();
+    let z = 0.05 - 9.81e-4 + 0.05 / wd * decay * (wd * t).sin();
+    let v = 0.05 / wd * decay * (wd * (wd * t).cos() - zeta * w0 * (wd * t).sin());
+    (z, v)
+}
+
+/// A tumbling asymmetric box without forces: the gyroscopic term alone
+/// turns the rotation axis; 0.4 s at steps of `dt` with `integrator`, its
+/// Newton iterations (implicit integrators) to `newton_tolerance`.
+pub fn tumbling(integrator: &str, dt: f64, newton_tolerance: f64) -> Simulation {
+    sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.4
+        dt = {dt}
+        output_interval = 0.4
+        integrator = "{integrator}"
+        newton = {{ tolerance = {newton_tolerance:e} }}
+        [record]
+        tables = []
+        [[bodies]]
+        name = "box"
+        shape = {{ type = "cuboid", half_extents = [0.1, 0.05, 0.02] }}
+        mass = 1.0
+        angular_velocity = [0.5, 4.0, 0.2]
+        "#
+    ))
+}
