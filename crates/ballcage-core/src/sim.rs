@@ -509,7 +509,7 @@ impl Simulation {
             // largest step, so a smaller step is not the cure.
             let why = format!(
                 "the adaptive steps went down to {:.3e} s (1/{} of the largest) without curing it",
-                self.model.dt * crate::integrate::MIN_STEP_FRACTION,
+                self.model.max_step * crate::integrate::MIN_STEP_FRACTION,
                 (1.0 / crate::integrate::MIN_STEP_FRACTION).round()
             );
             return Some((why, false));

@@ -289,6 +289,23 @@ fn the_run_metadata_counts_the_steps_and_the_estimate() {
 }
 
 #[test]
+fn a_tolerance_no_step_can_meet_fails_at_a_1024th_of_the_largest_step() {
+    // rtol 1e-15 with atol 1e-300: the oscillator's local error at a step of
+    // 10 ms/1024 (about (ω₀h)⁴ ~ 1e-12 of its amplitude) is far above it, so
+    // the steps shrink to the floor and the run stops there, saying so.
+    let mut sim = oscillator(0.01, "rtol = 1e-15\natol = 1e-300\nmax_step = 0.01");
+    let err = sim.run().expect_err("no step meets rtol 1e-15");
+    let text = err.to_string();
+    assert!(
+        text.contains("the error estimate of ESDIRK3(2)")
+            && text.contains("1/1024 of the largest step"),
+        "{text}"
+    );
+    let smallest = sim.error_stats().expect("esdirk32").smallest_step;
+    assert!(smallest >= 0.01 / 1024.0 * (1.0 - 1e-9), "{smallest}");
+}
+
+#[test]
 fn each_quantity_has_its_own_absolute_tolerance() {
     // The oscillator's velocity (≤ 0.05 m/s) is held by atol + rtol·|v|:
     // with rtol = 1e-6 its atol decides. A velocity atol 1000 times looser

@@ -243,8 +243,9 @@ impl Implicit {
         }
     }
 
-    /// Adaptive steps from `state.t` to `state.t + big` [s], none longer
-    /// than `big`.
+    /// Adaptive steps, none longer than `simulation.max_step`, until the
+    /// frame `big` [s] after `state.t` is reached or passed; `state` is then
+    /// that frame (interpolated when a step passed it).
     fn esdirk_adaptive(
         &mut self,
         model: &Model,
@@ -255,7 +256,10 @@ impl Implicit {
     ) -> Result<(), String> {
         let t_end = state.t + big;
         let mut cur = self.own_state(state, big);
-        let floor = MIN_STEP_FRACTION * big;
+        // The smallest step, relative to the largest (`simulation.max_step`,
+        // by default the output interval `big`).
+        let largest = model.max_step;
+        let floor = MIN_STEP_FRACTION * largest;
         while t_end - cur.t > 1e-12 * big {
             let es = self.esdirk.as_mut().expect("made by esdirk_step");
             // The first step: `max_step`.
@@ -278,7 +282,7 @@ impl Implicit {
                         Ok(())
                     } else {
                         cur.clone_from(&saved);
-                        too_small(h, floor).map_or(Ok(()), |why| {
+                        too_small(h, largest).map_or(Ok(()), |why| {
                             Err(format!(
                                 "the error estimate of ESDIRK3(2) is {err:.3e} times \
                                  simulation.rtol/atol {why}"
@@ -304,7 +308,7 @@ impl Implicit {
                     es.stats.smallest_step = es.stats.smallest_step.min(h);
                     Ok(())
                 }
-                Err(e) => Err(format!("{e} {}", too_small(h, floor).unwrap_or_default())),
+                Err(e) => Err(format!("{e} {}", too_small(h, largest).unwrap_or_default())),
             };
             self.esdirk.as_mut().expect("made").saved = Some(saved);
             result?;
