@@ -211,11 +211,15 @@ def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
     assert "retried in halves" in text and "is probably not the cause" in text, text
     assert "simulation.newton.max_iterations" in text
     assert _advised_step(text) is None, text
-    # The adaptive default shrinks its own step to 1/1024 of the largest before it gives up:
-    # the message says so, and does not advise a step either.
+    # The adaptive default shrinks its own step to 1/16384 of the largest before it gives up (here Newton cannot
+    # converge at any step: one iteration against a tolerance no increment meets): the message says so, and does
+    # not advise a step either.
     adaptive = default_scene(
-        ["pipe.joints=2", "simulation.duration=0.01", "simulation.newton.max_iterations=1", "simulation.newton.fallback=false"]
-    )
+        [
+            "pipe.joints=2", "simulation.duration=0.01", "simulation.newton.max_iterations=1",
+            "simulation.newton.tolerance=1e-300", "simulation.newton.fallback=false",
+        ]
+    )  # fmt: skip
     with pytest.raises(ballcage.SimulationError) as info:
         ballcage.simulate(adaptive)
     text = str(info.value)

@@ -44,8 +44,8 @@ TIMEOUT_S = 120.0  # s: generous, for a loaded 2-core machine
 POLL_S = 5e-4  # s between two looks at the output folder
 #: The run killed: ball keys, 2 joints, 0.1 s, a frame every step.
 KILLED_RUN = ("--set", "pipe.joints=2", "--set", "simulation.duration=0.1", "--set", "simulation.output_interval=1e-4")
-#: What it writes: its 9 default tables and scene.toml.
-FILES_PER_RUN = 10
+#: What it writes: its 9 default tables and scene.toml, then the wear map and its figure derived from them.
+TABLE_FILES, FILES_PER_RUN = 10, 12
 TEMPORARY = re.compile(r"^\.(?P<final>.+)\.[0-9a-f]{8}\.tmp$")
 #: A run that diverges in the middle: the ball drop on a 100x stiffer ground at 1 ms RK4 steps
 #: diverges on landing, at t = 0.102 s of 0.2 s (step 102 of 200).
@@ -128,9 +128,12 @@ def _assert_complete(path: Path) -> None:
 
 
 def _two_phase(counts: dict[str, int]) -> bool:
-    """Whether a killed run's folder fits writing every temporary before any rename: no final file yet,
-    or (killed within the renames) finals and temporaries together are the whole run."""
-    return counts["final"] == 0 or counts["final"] + counts["temporary"] == FILES_PER_RUN
+    """Whether a killed run's folder fits writing every temporary before any rename, tables first, then the
+    files derived from them: no final file yet, or (killed within the tables' renames) finals and temporaries
+    together are the tables, or every table final and the derived files' temporaries and finals at most the
+    rest of the run."""
+    final, total = counts["final"], counts["final"] + counts["temporary"]
+    return final == 0 or total == TABLE_FILES or (final >= TABLE_FILES and total <= FILES_PER_RUN)
 
 
 def _error_lines(log: Path) -> list[str]:

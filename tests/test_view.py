@@ -259,6 +259,10 @@ def test_mp4_export(run_dir: Path, tmp_path: Path) -> None:
         (["{run}", "--out", "{tmp}/a.png"], "'.png': the suffix picks the kind; write .html, .gif, .mp4"),
         (["{run}", "--out", "{tmp}/a.html", "--frames", "0"], "--frames 0: must be at least 1"),
         (["{run}", "--out", "{tmp}/a.html", "--fps", "-2"], "--fps -2: must be a positive number"),
+        (["{run}", "--out", "{tmp}/a.html", "--scale", "60"], "--scale 60: must be from 1 to 50"),
+        (["{run}", "--out", "{tmp}/a.html", "--scale", "0.5"], "--scale 0.5: must be from 1 to 50"),
+        (["{run}", "--out", "{tmp}/a.html", "--wear"], "no wear_map.parquet"),
+        (["{run}", "--out", "{tmp}/a.gif", "--wear"], "--wear: the wear colouring is drawn on the HTML page"),
     ],
 )
 def test_bad_input_exits_2_naming_it(args: list[str], expect: str, run_dir: Path, tmp_path: Path) -> None:
@@ -279,3 +283,83 @@ def test_write_view_refuses_a_generic_scene(tmp_path: Path) -> None:
 
     with pytest.raises(ballcage.InputError, match="scene kind = 'generic'"):
         write_view(run, tmp_path / "chain.html")
+
+
+@pytest.fixture(scope="module")
+def worn_run(tmp_path_factory) -> Path:
+    """0.12 s of the paper's scene by `ballcage run` (the links reach the wall at 0.08 s), its wear map in coarse
+    cells (50 mm × 30°) so that the worn wall shows at the view's distance."""
+    out = tmp_path_factory.mktemp("worn")
+    sets = [
+        "simulation.duration=0.12", "wear.map_cell_length=0.05", "wear.map_cell_angle_deg=30",
+        'record.tables=["bodies", "contacts", "links", "wear"]',
+    ]  # fmt: skip
+    proc = _cli("run", "--out", str(out), "--quiet", *(a for s in sets for a in ("--set", s)))
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+def test_the_displacement_scale_multiplies_each_offset_from_the_centreline(worn_run: Path) -> None:
+    from ballcage.view.scale import scaled
+
+    chain = chain_frames(read_run(worn_run), 5)
+    big = scaled(chain, 20.0)
+
+    def ends(c):
+        half = 0.5 * np.stack([c.lengths_at(f) for f in range(len(c.times))])[..., None] * c.axes
+        return np.stack([c.centres - half, c.centres + half], axis=2)
+
+    radius = 1.5  # the arc P(a) = (R(1 - cos a), 0, -R sin a) about (R, 0, 0): an end's exact offset is
+    # (R - its distance from the arc's axis) in the bend plane and y across it
+
+    def offset(points):
+        return np.stack([radius - np.hypot(points[..., 0] - radius, points[..., 2]), points[..., 1]], axis=-1)
+
+    on_arc = (ends(chain)[..., 2] < -0.01) & (ends(chain)[..., 0] < radius - 0.01)
+    true = offset(ends(chain))[on_arc]
+    assert np.abs(true).max() > 0.005  # the fold: links off the centreline by millimetres
+    # to within the view's centreline samples (20 mm apart: 33 µm off the arc, 0.7 mm at x20)
+    np.testing.assert_allclose(offset(ends(big))[on_arc], 20.0 * true, atol=1e-3)
+    assert np.abs(offset(ends(big))[on_arc] - true).max() > 0.09  # and the 20 times is seen: 0.1 m and more
+    # the chain stays connected: two bodies' ends at a hinge stay within 20 times their true distance
+    def gap(c):
+        return np.linalg.norm(ends(c)[:, 1:, 0] - ends(c)[:, :-1, 1], axis=-1)
+
+    assert np.all(gap(big) <= 20.0 * gap(chain) + 1e-9)
+    assert big.scale == 20.0 and scaled(chain, 1.0) is chain
+
+
+def _worn_coloured(pixels: np.ndarray) -> np.ndarray:
+    """Which pixels are in the wear scale's colours (orange to dark red): saturated, hue within 40° of red."""
+    flat = pixels.reshape(-1, 3)
+    high, low = flat.max(axis=1), flat.min(axis=1)
+    saturation = np.where(high > 0, (high - low) / np.maximum(high, 1e-9), 0.0)
+    hue = np.array([360.0 * colorsys.rgb_to_hsv(*rgb)[0] for rgb in flat])
+    return (saturation > 0.45) & (high > 0.3) & ((hue <= 40.0) | (hue >= 340.0))
+
+
+@needs_chromium
+def test_chromium_draws_the_scaled_chain_and_the_worn_tube_wall(worn_run: Path, tmp_path: Path) -> None:
+    """The same page at ×20 with and without --wear: the worn cells are in the WebGL scene and on the screen."""
+    import pyarrow.parquet as pq
+
+    pages = {}
+    for name, extra in (("plain", []), ("worn", ["--wear"])):
+        out = tmp_path / f"{name}.html"
+        proc = _cli("view", str(worn_run), "--out", str(out), "--frames", "5", "--scale", "20", *extra)
+        assert proc.returncode == 0, proc.stderr
+        status = _chromium(out.as_uri() + "#t=0.12", tmp_path / f"{name}.png", tmp_path / "profile")
+        pages[name] = (out, status, _scene_pixels(tmp_path / f"{name}.png", status))
+    worn_cells = sum(1 for r in pq.read_table(worn_run / "wear_map.parquet").to_pylist() if r["surface"] == "tube")
+    (_, s_plain, p_plain), (worn, s_worn, p_worn) = pages["plain"], pages["worn"]
+
+    assert s_worn["data-scale"] == s_plain["data-scale"] == "20"
+    assert "DISPLACEMENT SCALE" in worn.read_text(encoding="utf-8") and "20 times true size" in worn.read_text(encoding="utf-8")
+    assert s_worn["data-drawn-wear"] == "true" and int(s_worn["data-wear-faces"]) == 2 * worn_cells > 0
+    assert s_plain["data-wear-faces"] == "0" and s_plain["data-drawn-wear"] == "false"
+    _assert_drawn(p_plain)
+    _assert_drawn(p_worn)
+    # the wear colour bar sits on the scene's left: compare the rest of the scene
+    left = 220
+    assert int(_worn_coloured(p_plain[:, left:]).sum()) < 5
+    assert int(_worn_coloured(p_worn[:, left:]).sum()) >= 30

@@ -93,8 +93,9 @@ def wear_line(wear: pa.Table) -> str | None:
     if wearing:
         r = min(wearing, key=lambda r: r["hours_per_100um"])
         line += (
-            f"; 0.1 mm of wear first at {r['pair']} ({_part(r)}) after {r['hours_per_100um']:.3g} h of this duty "
-            "(Archard, wear.*_coefficient k; scales with k)"
+            f"; a spot that stayed under the contact would wear 0.1 mm first at {r['pair']} ({_part(r)}) after "
+            f"{r['hours_per_100um']:.3g} h of this duty (Archard, scales with k; a lower bound on the hours: the "
+            "contact moves, the wear map's figure follows)"
         )
     return line
 

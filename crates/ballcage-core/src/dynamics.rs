@@ -69,6 +69,35 @@ impl ContactEval {
     pub fn force(&self) -> Vec3 {
         self.point.normal * self.normal_force + self.tangential_force
     }
+
+    fn new(point: ContactPoint, law: &PointLaw) -> Self {
+        Self {
+            point,
+            depth_rate: law.depth_rate,
+            normal_force: law.normal_force,
+            tangential_force: law.tangential_force,
+            slip_speed: law.slip_speed,
+        }
+    }
+}
+
+/// What the laws of one contact point give: [`ContactEval`] without its
+/// point, so that an evaluation does not copy the points (the fields as
+/// there).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PointLaw {
+    depth_rate: f64,
+    normal_force: f64,
+    tangential_force: Vec3,
+    slip_speed: f64,
+}
+
+impl PointLaw {
+    /// The point's contact force on body b [N], world frame.
+    #[inline]
+    fn force(&self, p: &ContactPoint) -> Vec3 {
+        p.normal * self.normal_force + self.tangential_force
+    }
 }
 
 /// Torque of all contact forces on `body` about its centre of mass [N·m],
@@ -132,7 +161,8 @@ impl Energy {
 #[derive(Debug, Clone, Default)]
 struct PairEval {
     points: Vec<ContactPoint>,
-    evals: Vec<(ContactEval, PointDerivatives)>,
+    /// The laws at each of `points`.
+    laws: Vec<(PointLaw, PointDerivatives)>,
 }
 
 /// Force evaluator with its scratch space and per-contact memory.
@@ -229,8 +259,15 @@ impl ContactWatch {
         }
     }
 
-    fn see(&mut self, k: usize, pair: &ContactPair, e: &ContactEval, d: &PointDerivatives) {
-        self.see_depth(k, pair, e.point.depth);
+    fn see(
+        &mut self,
+        k: usize,
+        pair: &ContactPair,
+        depth: f64,
+        e: &PointLaw,
+        d: &PointDerivatives,
+    ) {
+        self.see_depth(k, pair, depth);
         if e.normal_force <= 0.0 || !pair.reduced_mass.is_finite() {
             return;
         }
@@ -261,7 +298,7 @@ impl Dynamics {
                 .iter()
                 .map(|p| PairEval {
                     points: Vec::with_capacity(p.geometry.slots()),
-                    evals: Vec::with_capacity(p.geometry.slots()),
+                    laws: Vec::with_capacity(p.geometry.slots()),
                 })
                 .collect(),
             // A pool that cannot start leaves the evaluation on this thread:
@@ -418,9 +455,9 @@ impl Dynamics {
             }),
         }
         for (k, (pair, e)) in model.pairs.iter().zip(&self.pairs).enumerate() {
-            for (e, d) in &e.evals {
-                self.watch.see(k, pair, e, d);
-                let (f, p) = (e.force(), e.point.point);
+            for (point, (e, d)) in e.points.iter().zip(&e.laws) {
+                self.watch.see(k, pair, point.depth, e, d);
+                let (f, p) = (e.force(point), point.point);
                 let (a, b) = (pair.a, pair.b);
                 self.force[b] += f;
                 self.torque[b] += (p - state.pos[b]).cross(&f);
@@ -587,30 +624,38 @@ fn evaluate_pair(
 ) {
     let pair = &model.pairs[k];
     find_points(model, pair, state, &mut e.points);
-    if mode == Mode::Commit {
-        latch(latched, state, pair, &e.points);
-    }
-    e.evals.clear();
-    for p in &e.points {
-        let (ev, d) = evaluate_point_full(state, pair, p, latched);
-        if let Some(c) = c.as_deref_mut() {
-            c.add_contact_point(state, pair, &ev, &d, scale);
+    e.laws.clear();
+    if e.points.is_empty() {
+        // Most pairs, most of the time: nothing to evaluate, and nothing latched.
+        if mode == Mode::Commit {
+            latched.fill(None);
         }
-        e.evals.push((ev, d));
+        return;
+    }
+    let motion = PairMotion::of(state, pair);
+    if mode == Mode::Commit {
+        latch(latched, &motion, &e.points);
+    }
+    for p in &e.points {
+        let (law, d) = evaluate_point_full(&motion, pair, p, latched);
+        if let Some(c) = c.as_deref_mut() {
+            c.add_contact_point(state, pair, p, &law, &d, scale);
+        }
+        e.laws.push((law, d));
     }
 }
 
 /// Latches the approach speed of every point of `points` that has none
 /// (a contact onset) and forgets those of slots not in contact; `latched`
 /// is empty for laws that do not latch.
-fn latch(latched: &mut [Option<f64>], state: &State, pair: &ContactPair, points: &[ContactPoint]) {
+fn latch(latched: &mut [Option<f64>], motion: &PairMotion, points: &[ContactPoint]) {
     if latched.is_empty() {
         return;
     }
     // Slots of a pair stay below 128: 64 samples, and 2·64 − 1 for the level-set line law.
     let mut seen = [false; 128];
     for p in points {
-        let rate = depth_rate(state, pair, p);
+        let rate = -motion.relative_velocity(&p.point).dot(&p.normal);
         let slot = p.slot as usize;
         if latched[slot].is_none() {
             latched[slot] = Some(rate);
@@ -649,12 +694,30 @@ fn find_points(model: &Model, pair: &ContactPair, state: &State, out: &mut Vec<C
     }
 }
 
-fn relative_velocity(state: &State, pair: &ContactPair, p: &ContactPoint) -> Vec3 {
-    state.point_velocity(pair.b, &p.point) - state.point_velocity(pair.a, &p.point)
+/// A pair's two bodies as they move, read once for all its points: each
+/// body's velocity [m/s], angular velocity [rad/s] (world frame) and centre
+/// of mass [m], a's then b's.
+struct PairMotion {
+    a: (Vec3, Vec3, Vec3),
+    b: (Vec3, Vec3, Vec3),
 }
 
-fn depth_rate(state: &State, pair: &ContactPair, p: &ContactPoint) -> f64 {
-    -relative_velocity(state, pair, p).dot(&p.normal)
+impl PairMotion {
+    fn of(state: &State, pair: &ContactPair) -> Self {
+        let body = |i: usize| (state.vel[i], state.omega_world(i), state.pos[i]);
+        Self {
+            a: body(pair.a),
+            b: body(pair.b),
+        }
+    }
+
+    /// The velocity of b's material point at `p` relative to a's [m/s]
+    /// (as [`State::point_velocity`]).
+    #[inline]
+    fn relative_velocity(&self, p: &Vec3) -> Vec3 {
+        let at = |(v, w, x): &(Vec3, Vec3, Vec3)| v + w.cross(&(p - x));
+        at(&self.b) - at(&self.a)
+    }
 }
 
 fn evaluate_point(
@@ -663,7 +726,8 @@ fn evaluate_point(
     p: &ContactPoint,
     latched: &[Option<f64>],
 ) -> ContactEval {
-    evaluate_point_full(state, pair, p, latched).0
+    let motion = PairMotion::of(state, pair);
+    ContactEval::new(*p, &evaluate_point_full(&motion, pair, p, latched).0)
 }
 
 /// Derivatives of one contact point's forces.
@@ -680,12 +744,12 @@ struct PointDerivatives {
 /// The per-point laws: forces and their velocity derivatives.
 #[inline]
 fn evaluate_point_full(
-    state: &State,
+    motion: &PairMotion,
     pair: &ContactPair,
     p: &ContactPoint,
     latched: &[Option<f64>],
-) -> (ContactEval, PointDerivatives) {
-    let rel = relative_velocity(state, pair, p);
+) -> (PointLaw, PointDerivatives) {
+    let rel = motion.relative_velocity(&p.point);
     let rate = -rel.dot(&p.normal);
     let approach = latched
         .get(p.slot as usize)
@@ -707,8 +771,7 @@ fn evaluate_point_full(
         _ => (Vec3::zeros(), Mat3::zeros()),
     };
     (
-        ContactEval {
-            point: *p,
+        PointLaw {
             depth_rate: rate,
             normal_force: w * fnormal,
             tangential_force: w * tangential,
@@ -767,17 +830,18 @@ impl CouplingJacobian {
         &mut self,
         state: &State,
         pair: &ContactPair,
-        e: &ContactEval,
+        point: &ContactPoint,
+        e: &PointLaw,
         d: &PointDerivatives,
         scale: f64,
     ) {
-        let g = contact_velocity_gradient(e, d, scale);
+        let g = contact_velocity_gradient(&point.normal, e, d, scale);
         if g != Mat3::zeros() {
-            let p = e.point.point;
+            let p = point.point;
             self.add_gradient(&g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
         }
         if scale != 0.0 && e.normal_force != 0.0 {
-            self.add_turning(state, pair, e, scale, scale * d.d_depth);
+            self.add_turning(state, pair, (point, e), scale, scale * d.d_depth);
         }
     }
 
@@ -794,9 +858,16 @@ impl CouplingJacobian {
     /// The friction force's turning is left out (it is μ times smaller and
     /// vanishes at rest). `k` = s·∂F_n/∂δ, for a centre that moves on its
     /// body into or out of the wall ([`CentreMotion::Rim`]).
-    fn add_turning(&mut self, state: &State, pair: &ContactPair, e: &ContactEval, s: f64, k: f64) {
-        let t = &e.point.turning;
-        let n = e.point.normal;
+    fn add_turning(
+        &mut self,
+        state: &State,
+        pair: &ContactPair,
+        (point, e): (&ContactPoint, &PointLaw),
+        s: f64,
+        k: f64,
+    ) {
+        let t = &point.turning;
+        let n = point.normal;
         let (p, q, sigma) = if t.centre_on_b {
             (pair.b, pair.a, 1.0)
         } else {
@@ -995,8 +1066,8 @@ impl VelocityJacobian {
 /// With a stiffness scale s the normal stiffness joins the damping: the
 /// point's relative displacement s·v_rel deepens the contact by −s·n·v_rel,
 /// so ∂F_n/∂δ̇ becomes ∂F_n/∂δ̇ + s·∂F_n/∂δ.
-fn contact_velocity_gradient(e: &ContactEval, d: &PointDerivatives, s: f64) -> Mat3 {
-    let n = e.point.normal;
+fn contact_velocity_gradient(n: &Vec3, e: &PointLaw, d: &PointDerivatives, s: f64) -> Mat3 {
+    let n = *n;
     let mut g = d.friction * (Mat3::identity() - n * n.transpose());
     let normal = d.d_rate + s * d.d_depth;
     if e.normal_force != 0.0 && normal != 0.0 {

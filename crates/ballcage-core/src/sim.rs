@@ -505,7 +505,7 @@ impl Simulation {
             return Some((why, true));
         }
         if self.model.tolerance.is_some() {
-            // Adaptive steps: the integrator only gives up at 1/1024 of the
+            // Adaptive steps: the integrator only gives up at MIN_STEP_FRACTION of the
             // largest step, so a smaller step is not the cure.
             let why = format!(
                 "the adaptive steps went down to {:.3e} s (1/{} of the largest) without curing it",

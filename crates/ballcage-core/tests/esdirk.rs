@@ -298,20 +298,26 @@ fn the_run_metadata_counts_the_steps_and_the_estimate() {
 }
 
 #[test]
-fn a_tolerance_no_step_can_meet_fails_at_a_1024th_of_the_largest_step() {
-    // rtol 1e-15 with atol 1e-300: the oscillator's local error at a step of
-    // 10 ms/1024 (about (ω₀h)⁴ ~ 1e-12 of its amplitude) is far above it, so
-    // the steps shrink to the floor and the run stops there, saying so.
-    let mut sim = oscillator(0.01, "rtol = 1e-15\natol = 1e-300\nmax_step = 0.01");
-    let err = sim.run().expect_err("no step meets rtol 1e-15");
+fn a_tolerance_no_step_can_meet_fails_at_a_16384th_of_the_largest_step() {
+    // rtol 1e-20 with atol 1e-300: below the round-off of the estimate
+    // itself (1e-16 of the amplitude), so no step meets it; the steps
+    // shrink to the floor, 10 ms/16384, and the run stops there, saying
+    // so. The controller shrinks a rejected step by at most a factor of 5,
+    // so the last one tried lies between a fifth of the floor and the floor.
+    let mut sim = oscillator(0.01, "rtol = 1e-20\natol = 1e-300\nmax_step = 0.01");
+    let err = sim.run().expect_err("no step meets rtol 1e-20");
     let text = err.to_string();
     assert!(
         text.contains("the error estimate of ESDIRK3(2)")
-            && text.contains("1/1024 of the largest step"),
+            && text.contains("1/16384 of the largest step"),
         "{text}"
     );
     let smallest = sim.error_stats().expect("esdirk32").smallest_step;
-    assert!(smallest >= 0.01 / 1024.0 * (1.0 - 1e-9), "{smallest}");
+    let floor = 0.01 / 16384.0;
+    assert!(
+        smallest >= 0.2 * floor * (1.0 - 1e-9) && smallest <= floor,
+        "{smallest}"
+    );
 }
 
 #[test]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 from pathlib import Path
+from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ballcage import _native
 from ballcage.cli._common import (
@@ -25,6 +27,9 @@ from ballcage.run import VERIFY_FILE, Run, simulate
 from ballcage.studies.common import implicit_steps, newton_per_stage
 from ballcage.verify import VerificationError, disagreements, verdict
 
+if TYPE_CHECKING:
+    import pyarrow as pa
+
 
 def add(commands: Commands) -> None:
     run = commands.add_parser(
@@ -33,7 +38,8 @@ def add(commands: Commands) -> None:
         description=(
             "Simulate a scene; write <table>.parquet for each recorded table and the resolved scene.toml. "
             "The tables are the scene's record.tables; a drill-pipe scene records by default bodies, "
-            "contacts and the engineering tables links, hinges, keys, drive, summary, pairs and wear. "
+            "contacts and the engineering tables links, hinges, keys, drive, summary, pairs and wear, and from "
+            "them fatigue.parquet and fatigue.png (life at the links' critical sections, docs/model.md §8.6). "
             "--tables chooses the tables instead."
         ),
     )
@@ -98,18 +104,71 @@ def command(args: argparse.Namespace) -> int:
         _write(partial, out, args.quiet)
         return _failed(e, partial, out)
     _write(result, out, args.quiet)
+    fatigue = _fatigue(result, out, args.quiet)
+    wear_map = _wear_map(result, out, args.quiet)
     if not args.quiet:
-        _report(result)
+        _report(result, fatigue, wear_map)
     return 0
 
 
 def _write(result: Run, out: Path, quiet: bool) -> None:
     """Writes `result` into `out` and, unless `quiet`, prints one line per file."""
+    for derived in ("wear_map.parquet", "wear_map.png"):  # an earlier run's, never beside this run's tables
+        (out / derived).unlink(missing_ok=True)
     paths = result.write(out)
     if not quiet:
         for name, path in paths.items():
             table = result.verification.table if name == "verify" and result.verification else result.tables.get(name)
             print(_summary(name, path, table))
+
+
+def _fatigue(result: Run, out: Path, quiet: bool) -> pa.Table | None:
+    """fatigue.parquet and fatigue.png (life at the links' critical sections) of a drill-pipe run that recorded
+    bodies, contacts and pairs."""
+    from ballcage.paper.fatigue import FATIGUE_FIGURE, FATIGUE_FILE, write_fatigue
+
+    ready = all(t in result.tables for t in ("bodies", "contacts", "pairs"))
+    return _derived(result, out, quiet, ("fatigue", "fatigue table"), write_fatigue, ready, (FATIGUE_FILE, FATIGUE_FIGURE))
+
+
+def _wear_map(result: Run, out: Path, quiet: bool) -> pa.Table | None:
+    """wear_map.parquet and wear_map.png (Archard depth per surface cell) of a drill-pipe run that recorded bodies,
+    contacts and wear or pairs."""
+    from ballcage.paper.wear_map import WEAR_FIGURE_FILE, WEAR_MAP_FILE, write_wear_map
+
+    ids = "wear" in result.tables or "pairs" in result.tables
+    ready = ids and all(t in result.tables for t in ("bodies", "contacts"))
+    return _derived(result, out, quiet, ("wear_map", "wear map"), write_wear_map, ready, (WEAR_MAP_FILE, WEAR_FIGURE_FILE))
+
+
+def _derived(
+    result: Run,
+    out: Path,
+    quiet: bool,
+    name: tuple[str, str],
+    write: Callable[[Run, Path], tuple[pa.Table, dict[str, Path]]],
+    ready: bool,
+    files: tuple[str, ...],
+) -> pa.Table | None:
+    """A table computed from a drill-pipe run's tables, with its figure: `write(result, out)` gives the table and the
+    paths ``<key>`` and ``<key>_figure``, `name` = (key, what to call it). Returns the table, or ``None`` with a note
+    why not (unless `quiet`), an earlier run's `files` then removed so that none lies beside this run's tables."""
+    key, called = name
+    if result.scene.kind == "drill-pipe" and ready:
+        try:
+            table, paths = write(result, out)
+        except _native.InputError as e:
+            if not quiet:
+                print(f"ballcage: no {called}: {e}")
+        else:
+            if not quiet:
+                figure = paths[f"{key}_figure"]
+                print(_summary(key, paths[key], table))
+                print(f"wrote {figure}  (figure, {human_size(figure.stat().st_size)})")
+            return table
+    for file in files:
+        (out / file).unlink(missing_ok=True)
+    return None
 
 
 def _failed(error: BaseException, written: Run, out: Path) -> int:
@@ -121,8 +180,8 @@ def _failed(error: BaseException, written: Run, out: Path) -> int:
     return fail(f"{written.error}; the output in {out} is incomplete (written up to then, ballcage.complete = false)", code)
 
 
-def _report(result: Run) -> None:
-    """The lines after the files: the run's cost, wear, fallback steps and, last, its verification."""
+def _report(result: Run, fatigue: pa.Table | None = None, wear_map: pa.Table | None = None) -> None:
+    """The lines after the files: the run's cost, wear, fatigue, fallback steps and, last, its verification."""
     print(_cost(result.metadata))
     if "wear" in result.tables:
         from ballcage.duty import margin_line, wear_line
@@ -130,6 +189,18 @@ def _report(result: Run) -> None:
         for line in (margin_line(result.tables["wear"]), wear_line(result.tables["wear"])):
             if line is not None:
                 print(f"ballcage: {line}")
+    if wear_map is not None:
+        from ballcage.measures.wear_map import hours_line
+
+        line = hours_line(wear_map)
+        if line is not None:
+            print(f"ballcage: {line}")
+    if fatigue is not None:
+        from ballcage.measures.fatigue import fatigue_line
+
+        line = fatigue_line(fatigue)
+        if line is not None:
+            print(f"ballcage: {line}")
     if result.fallback_note is not None:
         print(f"ballcage: warning: {result.fallback_note}")
     if result.verification is not None:
@@ -140,7 +211,7 @@ def _report(result: Run) -> None:
 
 def _earlier_run(out: Path) -> list[str]:
     """Files of an earlier run in `out`: its ``<table>.parquet``, ``scene.toml`` and ``verify.parquet``."""
-    files = [f"{t}.parquet" for t in _native.TABLE_NAMES] + ["scene.toml", VERIFY_FILE]
+    files = [f"{t}.parquet" for t in _native.TABLE_NAMES] + ["scene.toml", VERIFY_FILE, "fatigue.parquet", "wear_map.parquet"]
     return [n for n in files if (out / n).exists()]
 
 

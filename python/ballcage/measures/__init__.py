@@ -6,7 +6,10 @@ revolution), `shape` (the most deformed joint, the hinge with the largest mean
 bend over a revolution, and included angles projected on the bend plane),
 `motion` (a link's range of motion: its centre's peak-to-peak excursion),
 `places` (where the forces are largest: the tube force along the chain, the
-key-force peak's hinge, time and drive stage) and `quantities` (every quantity of a
+key-force peak's hinge, time and drive stage), `sections` (the internal loads
+at each link's neck, body and seat from a free-body cut of the rigid link),
+`fatigue` (their stress cycles and fatigue life: rainflow, Basquin–Goodman,
+Miner; ``fatigue.parquet``) and `quantities` (every quantity of a
 sweep case; `DRILL_PIPE`, the plug-in ``ballcage sweep``, ``ballcage chart``
 and ``ballcage paper --sweeps`` pass to `ballcage.sweep`). The paper's
 comparison (`ballcage.paper`) takes its values from here and adds its notes.

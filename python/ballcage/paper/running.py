@@ -13,8 +13,10 @@ from ballcage import _native
 from ballcage._files import write_parquet, write_text
 from ballcage.duty import write_loss_figure
 from ballcage.paper.compare import comparison, with_spread
+from ballcage.paper.fatigue import fatigue_markdown, write_fatigue_or_why
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
+from ballcage.paper.wear_map import wear_map_markdown, write_wear_map
 from ballcage.run import simulate
 from ballcage.scene import default_scene, override_list
 from ballcage.view import write_view
@@ -31,7 +33,7 @@ __all__ = ["PAPER_TABLES", "SENSITIVITY_FILE", "find_sensitivity", "paper_scene"
 #: The 3D view `run_paper` writes beside the figures (`ballcage view`), and its most frames (evenly spaced).
 VIEW_FILE, VIEW_FRAMES = "chain.html", 120
 #: Tables the paper run records.
-PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive", "wear")
+PAPER_TABLES: tuple[str, ...] = ("bodies", "contacts", "summary", "links", "hinges", "keys", "drive", "pairs", "wear")
 #: The loss breakdown `run_paper` writes beside the figures (`ballcage.duty.write_loss_figure`).
 LOSS_FILE = "losses.png"
 #: A sensitivity study's table (``ballcage sensitivity --out DIR``) that `run_paper` looks for in its folder.
@@ -65,7 +67,10 @@ def run_paper(
 
     Returns the written paths: one per table (``"bodies"``, …), ``"scene"``,
     one per figure (``"fig09_included_angles"``, …), ``"losses"`` (``losses.png``,
-    the friction loss by contact, `ballcage.duty`), ``"view"`` (``chain.html``,
+    the friction loss by contact, `ballcage.duty`), ``"fatigue"`` and ``"fatigue_figure"`` (``fatigue.parquet``,
+    ``fatigue.png``: life at the links' critical sections, `ballcage.measures.fatigue`), ``"wear_map"`` and
+    ``"wear_map_figure"`` (``wear_map.parquet``, ``wear_map.png``: Archard depth per surface cell,
+    `ballcage.measures.wear_map`), ``"view"`` (``chain.html``,
     the chain turning in 3D, `ballcage.view`), ``"comparison"``,
     ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder),
     ``"fig16_curvature"``, ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``.
@@ -94,6 +99,9 @@ def run_paper(
     written = run.write(out)
     written.update(write_figures(run, out))
     written["losses"] = write_loss_figure(run.tables["wear"], out / LOSS_FILE)
+    fatigue = write_fatigue_or_why(run, out, written)
+    wear_map, wear_paths = write_wear_map(run, out)
+    written.update(wear_paths)
     written["view"] = write_view(run, out / VIEW_FILE, frames=VIEW_FRAMES)
     section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
     sweep_runs = section4[0].variant_runs() if section4 is not None else None
@@ -108,7 +116,9 @@ def run_paper(
         sweep_runs=sweep_runs,
         section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
     )
-    written["comparison_md"] = write_text(md, out / "comparison.md")
+    spot = [r["hours_per_100um"] for r in run.tables["wear"].to_pylist() if r["hours_per_100um"] is not None]
+    md += wear_map_markdown(wear_map, min(spot) if spot else None)
+    written["comparison_md"] = write_text(md + fatigue_markdown(fatigue), out / "comparison.md")
     return written
 
 

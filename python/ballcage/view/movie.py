@@ -106,7 +106,7 @@ def _scene_figure(chain: ChainFrames) -> tuple[Figure, Any]:
         bodies.set_facecolor(colours)
         if marks:
             sides = chain.sides[f]  # type: ignore[index]
-            ends = spin_marks(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths).reshape(-1, 2, 3)
+            ends = spin_marks(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths_at(f)).reshape(-1, 2, 3)
             centres = np.repeat(chain.centres[f], 2, axis=0)
             facing = (ends.mean(axis=1) - centres) @ towards_viewer > 0  # marks on the far side are hidden
             for line, (a, b), shown in zip(marks, ends, facing):
@@ -131,7 +131,7 @@ def _towards_viewer(ax: Any) -> np.ndarray:
 def _body_polygons(chain: ChainFrames, f: int, norm: Any, cmap: Any) -> tuple[list[np.ndarray], np.ndarray]:
     """Each body's side quads and two caps at frame `f`, and their shaded colours (links by tube force)."""
     sides = chain.sides[f] if chain.sides is not None else None
-    vertices = cylinder_vertices(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths, _SIDES)
+    vertices = cylinder_vertices(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths_at(f), _SIDES)
     s = np.arange(_SIDES)
     nxt = (s + 1) % _SIDES
     polygons: list[np.ndarray] = []

@@ -23,6 +23,7 @@ import numpy as np
 
 from ballcage.view.meshes import cylinder_triangles, cylinder_vertices, spin_marks, tube_mesh, tube_rings
 from ballcage.view.poses import TUBE_SPACING, ChainFrames
+from ballcage.view.wear import WallWear, wall_mesh
 
 __all__ = ["COLORSCALE", "STATUS_ID", "view_html"]
 
@@ -30,8 +31,11 @@ __all__ = ["COLORSCALE", "STATUS_ID", "view_html"]
 COLORSCALE = "Viridis"
 #: id of the marker the page writes after its first render.
 STATUS_ID = "ballcage-status"
-#: Static traces before the moving ones: the tube's wall and its rings.
+#: Static traces before the moving ones: the tube's wall and its rings (and its worn cells, when coloured by wear).
 TUBE_TRACES = 2
+#: plotly colour scale of the tube wall's wear depth, 0 to the deepest cell: orange to dark red, apart from the
+#: links' viridis (only worn cells are drawn, so even the shallowest is saturated).
+WEAR_COLORSCALE = [[0.0, "#feb24c"], [0.5, "#f03b20"], [1.0, "#800026"]]
 #: Opacity of the tube wall: more would show WebGL's blending as swirls over the links behind it.
 _TUBE_OPACITY = 0.1
 #: Spacing [m] of the rings outlining the tube.
@@ -73,16 +77,24 @@ ready.then(function () {
   marker.setAttribute('data-keys', String(keys.length ? keys[0]._length || 0 : 0));
   marker.setAttribute('data-scene-box', box.map(Math.round).join(','));
   marker.setAttribute('data-time', wanted && frames.length ? best.name : frames.length ? frames[0].name : '');
+  var meta = (gd.layout && gd.layout.meta) || {};
+  marker.setAttribute('data-scale', String(meta.scale || 1));
+  var wear = full.filter(function (t) { return t.meta === 'wear'; });
+  marker.setAttribute('data-wear-faces', String(wear.length ? wear[0].intensity.length : 0));
+  var wearGl = wear.length && scene && scene.glplot ? scene.traces[wear[0].uid] : null;
+  marker.setAttribute('data-drawn-wear', String(!!(wearGl && wearGl.mesh && scene.glplot.objects.indexOf(wearGl.mesh) >= 0)));
   document.body.appendChild(marker);
 });
 """.replace("STATUS_ID", STATUS_ID)
 
 
-def view_html(chain: ChainFrames, fps: float = 12.0) -> str:
-    """The page (HTML text) animating `chain` at `fps` frames per second, with plotly.js embedded."""
+def view_html(chain: ChainFrames, fps: float = 12.0, wall: WallWear | None = None) -> str:
+    """The page (HTML text) animating `chain` at `fps` frames per second, with plotly.js embedded; with `wall`, the
+    tube wall's worn cells drawn coloured by their wear depth (`ballcage.view.wear`)."""
     import plotly.io as pio  # deferred: only the view needs plotly
 
-    figure = {"data": _traces(chain, 0), "frames": _frames(chain), "layout": _layout(chain, fps)}
+    static = _tube(chain, wall)
+    figure = {"data": _traces(chain, 0, static), "frames": _frames(chain, len(static)), "layout": _layout(chain, fps, wall)}
     return pio.to_html(
         figure,
         include_plotlyjs=True,
@@ -117,7 +129,7 @@ def _force_range(chain: ChainFrames) -> tuple[float, float]:
 def _bodies(chain: ChainFrames, f: int) -> list[dict[str, Any]]:
     """The drawn bodies at frame `f`: vertices and, for links, the per-vertex tube force [N]."""
     sides = chain.sides[f] if chain.sides is not None else None
-    vertices = cylinder_vertices(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths)
+    vertices = cylinder_vertices(chain.centres[f], chain.axes[f], sides, chain.radii, chain.lengths_at(f))
     out = []
     for b in range(len(chain.labels)):
         trace: dict[str, Any] = {"x": _typed(vertices[b, :, 0]), "y": _typed(vertices[b, :, 1]), "z": _typed(vertices[b, :, 2])}
@@ -132,7 +144,7 @@ def _moving(chain: ChainFrames, f: int) -> list[dict[str, Any]]:
     """Everything that moves at frame `f`: bodies, spin marks, keys (in trace order after the tube)."""
     traces = _bodies(chain, f)
     if chain.sides is not None:
-        marks = spin_marks(chain.centres[f], chain.axes[f], chain.sides[f], chain.radii, chain.lengths)
+        marks = spin_marks(chain.centres[f], chain.axes[f], chain.sides[f], chain.radii, chain.lengths_at(f))
         traces.append(_polylines(marks.reshape(-1, 2, 3)))
     if chain.keys is not None:
         keys = chain.keys[f]
@@ -140,10 +152,11 @@ def _moving(chain: ChainFrames, f: int) -> list[dict[str, Any]]:
     return traces
 
 
-def _tube(chain: ChainFrames) -> list[dict[str, Any]]:
-    """The static traces: the tube's semi-transparent wall (unlit, so it only tints) and rings outlining it."""
+def _tube(chain: ChainFrames, wall: WallWear | None = None) -> list[dict[str, Any]]:
+    """The static traces: the tube's semi-transparent wall (unlit, so it only tints), rings outlining it and, with
+    `wall`, its worn cells coloured by depth [µm] (one colour per cell)."""
     vertices, triangles = tube_mesh(chain.tube)
-    wall = {
+    tint = {
         "type": "mesh3d", "name": "guide tube", "meta": "tube", "opacity": _TUBE_OPACITY, "color": _TUBE,
         "x": _typed(vertices[:, 0]), "y": _typed(vertices[:, 1]), "z": _typed(vertices[:, 2]),
         "i": _indices(triangles[:, 0]), "j": _indices(triangles[:, 1]), "k": _indices(triangles[:, 2]),
@@ -154,7 +167,18 @@ def _tube(chain: ChainFrames) -> list[dict[str, Any]]:
         "type": "scatter3d", "mode": "lines", "name": "guide tube rings", "meta": "tube", "hoverinfo": "skip",
         "line": {"color": _TUBE, "width": 2}, "connectgaps": False,
     }
-    return [wall, outline | _polylines(rings)]
+    traces = [tint, outline | _polylines(rings)]
+    if wall is not None:
+        worn, faces, depth = wall_mesh(chain.tube, wall)
+        traces.append({
+            "type": "mesh3d", "name": "tube wall wear", "meta": "wear", "opacity": 1.0, "coloraxis": "coloraxis2",
+            "x": _typed(worn[:, 0]), "y": _typed(worn[:, 1]), "z": _typed(worn[:, 2]),
+            "i": _indices(faces[:, 0]), "j": _indices(faces[:, 1]), "k": _indices(faces[:, 2]),
+            "intensity": _typed(1e6 * depth, 4), "intensitymode": "cell",
+            "hovertemplate": "wear %{intensity:.3g} µm<extra></extra>",
+            "lighting": {"ambient": 0.9, "diffuse": 0.2, "specular": 0.0, "fresnel": 0.0},
+        })  # fmt: skip
+    return traces
 
 
 def _polylines(lines: np.ndarray) -> dict[str, Any]:
@@ -163,8 +187,8 @@ def _polylines(lines: np.ndarray) -> dict[str, Any]:
     return {"x": _typed(gaps[:, 0]), "y": _typed(gaps[:, 1]), "z": _typed(gaps[:, 2])}
 
 
-def _traces(chain: ChainFrames, f: int) -> list[dict[str, Any]]:
-    """Every trace at frame `f`: the tube's first (static, `TUBE_TRACES` of them), then `_moving`'s."""
+def _traces(chain: ChainFrames, f: int, static: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
+    """Every trace at frame `f`: the tube's first (`static`, default `_tube`'s), then `_moving`'s."""
     faces = cylinder_triangles()
     styled: list[dict[str, Any]] = []
     moving = _moving(chain, f)
@@ -186,15 +210,14 @@ def _traces(chain: ChainFrames, f: int) -> list[dict[str, Any]]:
     if chain.keys is not None:
         keys = {"type": "scatter3d", "mode": "markers", "name": "ball keys", "meta": "keys", "hoverinfo": "skip"}
         styled.append(keys | {"marker": {"size": 4, "color": _KEYS}} | rest[0])
-    tube = _tube(chain)
-    assert len(tube) == TUBE_TRACES
+    tube = _tube(chain) if static is None else static
     return [*tube, *styled]
 
 
-def _frames(chain: ChainFrames) -> list[dict[str, Any]]:
+def _frames(chain: ChainFrames, static: int = TUBE_TRACES) -> list[dict[str, Any]]:
     count = len(_moving(chain, 0))
     return [
-        {"name": _frame_name(chain, f), "data": _moving(chain, f), "traces": list(range(TUBE_TRACES, TUBE_TRACES + count))}
+        {"name": _frame_name(chain, f), "data": _moving(chain, f), "traces": list(range(static, static + count))}
         for f in range(len(chain.times))
     ]
 
@@ -203,14 +226,24 @@ def _frame_name(chain: ChainFrames, f: int) -> str:
     return f"{chain.times[f]:.4f}"
 
 
-def _layout(chain: ChainFrames, fps: float) -> dict[str, Any]:
+def _layout(chain: ChainFrames, fps: float, wall: WallWear | None = None) -> dict[str, Any]:
     cmin, cmax = _force_range(chain)
     recorded = bool(np.isfinite(chain.tube_force[:, chain.is_link]).any())
     axis = {"showbackground": True, "backgroundcolor": "#f4f6f8", "gridcolor": "#d0d4d8"}
-    return {
-        "title": {"text": _title(chain, recorded), "x": 0.02, "font": {"size": 15}},
+    extra: dict[str, Any] = {"meta": {"scale": chain.scale}}
+    if wall is not None:
+        deepest = 1e6 * float(wall.depth.max())
+        extra["coloraxis2"] = {
+            "colorscale": WEAR_COLORSCALE, "cmin": 0.0, "cmax": deepest if deepest > 0 else 1.0,
+            "colorbar": {
+                "title": {"text": "tube wall wear [µm]"}, "len": 0.6, "x": 0.0, "xanchor": "left", "thickness": 18,
+                "exponentformat": "e",
+            },
+        }  # fmt: skip
+    return extra | {
+        "title": {"text": _title(chain, recorded, wall), "x": 0.02, "font": {"size": 15}},
         "showlegend": False,
-        "margin": {"l": 0, "r": 0, "t": 60, "b": 0},
+        "margin": {"l": 0, "r": 0, "t": 80 if chain.scale != 1.0 or wall is not None else 60, "b": 0},
         "scene": {
             "aspectmode": "data",
             "domain": {"x": [0.0, 0.88], "y": [0.0, 1.0]},
@@ -228,12 +261,22 @@ def _layout(chain: ChainFrames, fps: float) -> dict[str, Any]:
     }
 
 
-def _title(chain: ChainFrames, recorded: bool) -> str:
+def _title(chain: ChainFrames, recorded: bool, wall: WallWear | None = None) -> str:
     what = "links coloured by their tube normal force" if recorded else "tube force not recorded (no links table)"
     source = "" if chain.source == "bodies" else "; poses from the links table (eq. (4) axes: no spin, no connectors)"
     keys = f"; {chain.keys.shape[1]} ball keys" if chain.keys is not None else ""
     partial = "; the run stopped early" if not chain.complete else ""
-    return html.escape(f"ballcage: {chain.scene_name}: {what}{keys}{source}{partial}")
+    second = []
+    if chain.scale != 1.0:
+        second.append(f"DISPLACEMENT SCALE ×{chain.scale:g}: offsets from the tube centreline drawn {chain.scale:g} times true size (the tube at true scale)")
+    if wall is not None:
+        p = wall.params
+        second.append(
+            f"tube wall coloured by Archard wear depth over t = {p['window_start']:g}–{p['window_end']:g} s "
+            f"(wear map, {1e3 * p['cell_length']:g} mm × {p['cell_angle_deg']:g}° cells)"
+        )
+    line = html.escape(f"ballcage: {chain.scene_name}: {what}{keys}{source}{partial}")
+    return line + "".join(f"<br><span style='font-size:13px'>{html.escape(t)}</span>" for t in second)
 
 
 #: Animation options of a slider step: straight to its frame.

@@ -51,6 +51,7 @@ class TubeShape:
     tangents: np.ndarray  # (M, 3) unit tangents, down the tube
     outward: np.ndarray  # (M, 3) unit normals in the bend plane, toward the outer wall
     inner_radius: float  # [m]
+    s: np.ndarray | None = None  # (M,) arc length of each sample along the centreline [m] (negative above its start)
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,12 @@ class ChainFrames:
     tube: TubeShape
     scene_name: str
     complete: bool  # False for a run that stopped early (ballcage.complete = "false")
+    scale: float = 1.0  # the links' offsets from the tube centreline are drawn this many times true size
+    frame_lengths: np.ndarray | None = None  # (F, B) drawn lengths per frame [m] where a scale stretches them
+
+    def lengths_at(self, f: int) -> np.ndarray:
+        """The bodies' drawn lengths [m] at frame `f`: `lengths`, or as a displacement scale stretched them."""
+        return self.lengths if self.frame_lengths is None else self.frame_lengths[f]
 
     @property
     def links(self) -> int:
@@ -361,4 +368,5 @@ def tube_shape(scene: _native.Scene, spacing: float = TUBE_SPACING) -> TubeShape
         tangents=np.vstack([tangents[0], tangents]),
         outward=np.vstack([outward[0], outward]),
         inner_radius=geometry.tube_radius,
+        s=np.concatenate([[-geometry.connector_length], s[keep]]),
     )

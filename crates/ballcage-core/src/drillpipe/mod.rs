@@ -12,6 +12,7 @@
 //! | module | job |
 //! |---|---|
 //! | `spec` | the document: sections, defaults, validation |
+//! | `fatigue` | the `[fatigue]` section: critical sections of a link, S–N curve |
 //! | `provenance` | where each default comes from: the paper, a rule, a PROPOSAL (range and why) |
 //! | `expand` | document → scene + layout, one function per part |
 //! | `names` | the one place part names are formatted |
@@ -27,6 +28,7 @@
 pub mod chain;
 pub mod cv;
 mod expand;
+mod fatigue;
 mod ids;
 mod layout;
 pub mod names;
@@ -38,6 +40,7 @@ pub mod tables;
 pub mod wear;
 
 pub use expand::Expansion;
+pub use fatigue::FatigueSpec;
 pub use layout::{BodyPart, Feature, HingeLayout, KeyLayout, Layout, PairPart, Part};
 pub use provenance::PROVENANCE;
 pub use spec::{

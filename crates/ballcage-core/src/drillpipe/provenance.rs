@@ -409,4 +409,94 @@ pub const PROVENANCE: &[FieldOrigin] = &[
         (1e-9, 1e-6),
         "the handbook's lubricated span, 1e-9 to 1e-6; every joint wear figure scales with it",
     ),
+    FieldOrigin::setting(
+        "wear.threshold_pressure",
+        "0, no threshold: Archard's law as the handbooks state it; a casing-wear threshold is a choice of \
+         the user's (docs/model.md §8.3)",
+    ),
+    FieldOrigin::setting(
+        "wear.map_cell_length",
+        "10 mm, the resolution of the wear map along the tube and the links (docs/model.md §8.3)",
+    ),
+    FieldOrigin::setting(
+        "wear.map_cell_angle_deg",
+        "5°, the resolution of the wear map around the wall: 5.1 mm on the paper's 116 mm bore",
+    ),
+    FieldOrigin::setting(
+        "wear.map_depth",
+        "0.1 mm, the depth whose hours the report gives",
+    ),
+    // fatigue (docs/model.md §8.6)
+    FieldOrigin::proposal(
+        "fatigue.neck_offset",
+        Source::Invented,
+        "docs/model.md §8.6: the neck section just behind the neck's contact line with the seat's mouth \
+         (25.8 mm from the hinge centre at the articulation limit), where the mouth's load has its arm",
+        (0.026, 0.05),
+        "from the contact line to the head's Ø62 body; the bending moment grows with the offset",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.seat_offset",
+        Source::PaperReading,
+        "docs/model.md §8.6: just behind the seat's sphere (R_s = 32.01 mm), where the seat's tube \
+         carries every load of its hinge",
+        (0.03, 0.05),
+        "from the sphere's end to the link's side of the seat's grooves; the moment grows with the offset",
+    ),
+    FieldOrigin::paper(
+        "fatigue.head_bore_diameter",
+        "Table 1 row 4: ball head bore 30 mm",
+    ),
+    FieldOrigin::paper(
+        "fatigue.seat_bore_diameter",
+        "Table 1 row 4: ball seat bore 64 mm",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.neck_scf",
+        Source::Handbook,
+        "a shoulder fillet in bending, D/d = 62/38, r/d = 0.05 (a 2 mm fillet): K_t = 2.0 (Pilkey & \
+         Pilkey, Peterson's Stress Concentration Factors, 3rd ed., 2008, Chart 3.10)",
+        (1.5, 2.6),
+        "fillet radii from 5 mm (r/d = 0.13) down to 1 mm (r/d = 0.026) in the same chart; the damage \
+         goes as K_t^(-1/b), about K_t^11.5",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.body_scf",
+        Source::Handbook,
+        "a plain tube away from any change of section: K_t = 1 (Peterson's, 3rd ed., 2008)",
+        (1.0, 1.5),
+        "up to a mild circumferential groove or a small radial hole at mid-link",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.seat_scf",
+        Source::Handbook,
+        "the seat's sphere and its six groove run-outs ending in the Ø64 bore, read as an internal \
+         shoulder: K_t = 2.0 (Peterson's, 3rd ed., 2008, Chart 3.10 as for the neck)",
+        (1.5, 3.0),
+        "the run-out's radius is not given; a sharp groove end could reach 3",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.ultimate_strength",
+        Source::Handbook,
+        "35CrMo quenched and tempered: R_m ≥ 980 MPa (GB/T 3077-2015)",
+        (9.8e8, 1.13e9),
+        "the standard's minimum to a typical delivered strength; moves only Goodman's correction",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.strength_coefficient",
+        Source::Handbook,
+        "σ′_f = 1.5·R_m = 1470 MPa, the uniform material law for unalloyed and low-alloy steels \
+         (Bäumel & Seeger, Materials Data for Cyclic Loading, Supplement 1, Elsevier, 1990)",
+        (1.2e9, 1.8e9),
+        "the scatter of measured σ′_f of Q&T Cr-Mo steels about the uniform law (SAE 4130-4142, \
+         Boller & Seeger, 1987); the life goes as σ′_f^(-1/b)",
+    ),
+    FieldOrigin::proposal(
+        "fatigue.strength_exponent",
+        Source::Handbook,
+        "b = −0.087, the uniform material law for steels (Bäumel & Seeger, 1990)",
+        (-0.12, -0.07),
+        "measured b of Q&T Cr-Mo steels (Boller & Seeger, 1987); the life at a given amplitude is \
+         very sensitive to it",
+    ),
 ];

@@ -7,6 +7,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::fatigue::{FatigueSpec, LinkSize};
 use crate::error::SceneError;
 use crate::scene::{
     DivergenceSpec, FieldDoc, FieldUnits, FrictionLawSpec, IntegratorKind, LineLawSpec, NewtonSpec,
@@ -252,16 +253,15 @@ pub struct PipeSpec {
     /// Sample points along each link (rims included) that bracket the
     /// extrema of its depth in the tube (or, with `"patches"`, locate its
     /// contact patches); the force does not depend on this count once each
-    /// extremum has a bracket of its own. Default 33 (6.25 mm apart), a
-    /// numerical setting, not a PROPOSAL. On
-    /// the paper run (SDIRK2 at 100 µs for every count) the compared
-    /// quantities at 5 samples agree with those at 17 within 0.08 % (link
-    /// 10's peak tube force within 1.2 %), and at 17 with those at 33 within
-    /// 0.012 %: the sample count's effect, not the run's error. But a
-    /// maximum–minimum pair hidden between two samples joins the law with a
-    /// finite step when it reaches a sample, and those steps cost the
-    /// implicit integrator step halvings (over the paper's first 1.2 s:
-    /// 2612 at 5 samples, 935 at 17, 204 at 33; docs/paper.md).
+    /// extremum has a bracket of its own, and a maximum–minimum pair born
+    /// between two samples is found from the samples' slopes. Default 9
+    /// (25 mm apart), a numerical setting, not a PROPOSAL. On the paper run
+    /// at the default integrator (2026-11-26) every compared quantity at 5,
+    /// 9, 17 and 33 samples is within 0.35 % of the two-method reference
+    /// computed at 33 (0.6 s and 1.8 s; at 9: 0.11 % and 0.042 %), the
+    /// spread of the counts no larger than the run's own error, with the
+    /// same number of rejected steps within 6 %; 9 instead of 33 takes 10 %
+    /// fewer instructions (docs/performance.md).
     pub tube_contact_points: u32,
     /// How a link's line contact with the tube becomes point laws:
     /// `"level-sets"` (the IMPACT law at every depth maximum minus the law
@@ -366,7 +366,7 @@ impl Default for PipeSpec {
             connector_diameter: 0.122,
             connector_mass: 17.243,
             connector_inertia: [3.402e-2, 7.449e-2, 7.449e-2],
-            tube_contact_points: 33,
+            tube_contact_points: 9,
             tube_contact_law: LineLawSpec::LevelSets,
             neck_radius: 0.019,
             link_edge_radius: 0.002,
@@ -664,6 +664,17 @@ pub struct WearSpec {
     /// Inside the joints, boundary-lubricated steel. PROPOSAL: 1e-7
     /// (lubricated, 1e-6–1e-9: ibid.).
     pub internal_coefficient: f64,
+    /// Mean contact pressure [Pa] below which a contact wears nothing in
+    /// the wear map (`wear_map.parquet`). Setting: 0, no threshold.
+    pub threshold_pressure: f64,
+    /// Length [m] of a wear map cell along the tube's centreline, a link's
+    /// axis and a race's axis. Setting: 0.01.
+    pub map_cell_length: f64,
+    /// Angle [deg] of a wear map cell around the tube's wall and a link's
+    /// surface. Setting: 5.
+    pub map_cell_angle_deg: f64,
+    /// Wear depth [m] whose hours the wear map reports. Setting: 1e-4.
+    pub map_depth: f64,
 }
 
 impl Default for WearSpec {
@@ -671,6 +682,10 @@ impl Default for WearSpec {
         Self {
             tube_coefficient: 1e-4,
             internal_coefficient: 1e-7,
+            threshold_pressure: 0.0,
+            map_cell_length: 0.01,
+            map_cell_angle_deg: 5.0,
+            map_depth: 1e-4,
         }
     }
 }
@@ -687,6 +702,26 @@ impl WearSpec {
             "internal_coefficient",
             "-",
             "Archard wear coefficient k of the contacts inside the joints",
+        ),
+        FieldDoc::number(
+            "threshold_pressure",
+            "Pa",
+            "mean contact pressure below which a contact wears nothing (wear map; 0: no threshold)",
+        ),
+        FieldDoc::number(
+            "map_cell_length",
+            "m",
+            "wear map cell length along the tube's centreline, a link's axis and a race's axis",
+        ),
+        FieldDoc::number(
+            "map_cell_angle_deg",
+            "deg",
+            "wear map cell angle around the tube's wall and a link's surface",
+        ),
+        FieldDoc::number(
+            "map_depth",
+            "m",
+            "wear depth whose hours of the run's duty the wear map reports",
         ),
     ];
 
@@ -705,7 +740,17 @@ impl WearSpec {
                 ));
             }
         }
-        Ok(())
+        non_negative("wear.threshold_pressure", self.threshold_pressure)?;
+        positive("wear.map_cell_length", self.map_cell_length)?;
+        positive("wear.map_cell_angle_deg", self.map_cell_angle_deg)?;
+        if self.map_cell_angle_deg > 360.0 {
+            return Err(SceneError::new(
+                "wear.map_cell_angle_deg",
+                self.map_cell_angle_deg,
+                "must not exceed 360 (a cell cannot go round the wall more than once)",
+            ));
+        }
+        positive("wear.map_depth", self.map_depth)
     }
 }
 
@@ -743,13 +788,12 @@ pub struct DrillPipeSpec {
     #[serde(skip_serializing_if = "String::is_empty")]
     pub name: String,
     /// Time stepping. The paper's 1 ms is the output interval, not the step.
-    /// Default: SDIRK2 at fixed steps of 100 µs. Its error on the present
-    /// model (level-set tube law, 33 samples) is not measured; on the
-    /// patch-law model of 2026-11-23 SDIRK2 at 200, 100 and 50 µs had largest
-    /// errors of 0.52 %, 5.0 % and 0.52 % (the final bend of a nearly
-    /// straight link), not falling with the step (docs/accuracy.md, "What a
-    /// run's accuracy is today"). `ballcage run --verify` and `ballcage
-    /// accuracy` measure a run's error. Explicit
+    /// Default: the adaptive ESDIRK3(2) at `simulation.rtol` = 1e-4, steps
+    /// up to the output interval; every compared quantity within 0.2 % of
+    /// the two-method reference over 0.6 s and 1.8 s (docs/accuracy.md).
+    /// `simulation.rtol = 0` gives fixed steps of `simulation.dt` (100 µs).
+    /// `ballcage run --verify` and `ballcage accuracy` measure a run's
+    /// error. Explicit
     /// integrators need 0.1 µs here: at 1 µs the lubricated key friction (a
     /// damper of rate ~4e6 1/s at 10 kN) chatters, and even 0.2 µs drifts
     /// once the keys carry their full load (docs/paper.md).
@@ -768,6 +812,8 @@ pub struct DrillPipeSpec {
     pub materials: MaterialsSpec,
     /// Archard wear coefficients of the `wear` table.
     pub wear: WearSpec,
+    /// The critical sections of a link and its S–N curve (the fatigue output).
+    pub fatigue: FatigueSpec,
     /// What to record.
     pub record: PipeRecordSpec,
 }
@@ -816,6 +862,11 @@ impl DrillPipeSpec {
             "wear",
             "Archard wear coefficients of the wear table",
             WearSpec::FIELDS,
+        ),
+        FieldDoc::table(
+            "fatigue",
+            "the critical sections of a link and its S-N curve (fatigue output)",
+            FatigueSpec::FIELDS,
         ),
         FieldDoc::table("record", "what to record", PipeRecordSpec::FIELDS),
     ];
@@ -882,6 +933,7 @@ impl Default for DrillPipeSpec {
             load: ResistingMomentSpec::default(),
             materials: MaterialsSpec::default(),
             wear: WearSpec::default(),
+            fatigue: FatigueSpec::default(),
             record: PipeRecordSpec::default(),
         }
     }
@@ -995,6 +1047,11 @@ impl DrillPipeSpec {
             self.materials.pipe_steel.validate("materials.pipe_steel"),
             self.materials.key_steel.validate("materials.key_steel"),
             self.wear.validate(),
+            self.fatigue.validate(LinkSize {
+                pitch: self.pipe.pitch,
+                neck_radius: self.pipe.neck_radius,
+                link_diameter: self.pipe.link_diameter,
+            }),
             self.record.validate_tables(self.simulation.duration),
         ])
     }

@@ -124,13 +124,13 @@ const WEAR_COLUMNS: &[ColumnDef] = &[
         "wear_depth_rate",
         OptF64,
         "m/s",
-        "Archard depth rate at a spot that stays under the contact, k/H · mean of p_mean·v_slip over the window (p_mean from Hertz); an upper bound for a surface the contact moves over; null without a Hertz model",
+        "UPPER BOUND of the Archard depth rate: a spot that stays under the contact, k/H · mean of p_mean·v_slip over the window (p_mean from Hertz); the contacts move over the surfaces, so the wear map (wear_map.parquet, depth per surface cell) gives the depth to use; null without a Hertz model",
     ),
     col(
         "hours_per_100um",
         OptF64,
         "h",
-        "hours of this duty to wear 0.1 mm at wear_depth_rate; null where nothing wears",
+        "LOWER BOUND of the hours of this duty to wear 0.1 mm: at the upper-bound wear_depth_rate (the wear map's hours_to_depth is the figure to use); null where nothing wears",
     ),
     col(
         "pressure_peak",

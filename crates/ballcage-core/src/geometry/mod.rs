@@ -371,7 +371,7 @@ impl PairGeometry {
     /// Appends the contact points of shapes 1 and 2 at the given poses, with
     /// normals from shape 1 toward shape 2 (canonical order).
     pub fn contacts(
-        self,
+        &self,
         s1: &Shape,
         p1: (&Vec3, &Quat),
         s2: &Shape,
@@ -390,7 +390,7 @@ impl PairGeometry {
                     radius,
                     half_length,
                 },
-            ) => line::cylinder_tube(t, p1, *radius, *half_length, line, p2, out),
+            ) => line::cylinder_tube(t, p1, *radius, *half_length, *line, p2, out),
             (Self::BallTube, Shape::Tube(t), Shape::Ball(b)) => ball_tube(t, p1, b.radius, p2, out),
             (
                 Self::TorusBall {
@@ -403,11 +403,11 @@ impl PairGeometry {
                 _,
                 _,
             ) => torus_ball(
-                &centre,
-                &axis,
-                core_radius,
-                tube_radius,
-                ball_radius,
+                centre,
+                axis,
+                *core_radius,
+                *tube_radius,
+                *ball_radius,
                 p1,
                 p2,
                 out,
@@ -421,7 +421,7 @@ impl PairGeometry {
                 },
                 _,
                 _,
-            ) => slot_ball(&centre, &normal, half_width, ball_radius, p1, p2, out),
+            ) => slot_ball(centre, normal, *half_width, *ball_radius, p1, p2, out),
             (
                 Self::CavitySphere {
                     cavity_centre,
@@ -434,7 +434,7 @@ impl PairGeometry {
             ) => {
                 let oa = p1.0 + p1.1 * cavity_centre;
                 let ob = p2.0 + p2.1 * sphere_centre;
-                cavity_sphere(&oa, cavity_radius, &ob, sphere_radius, out)
+                cavity_sphere(&oa, *cavity_radius, &ob, *sphere_radius, out)
             }
             (Self::RingCylinder(r), _, _) => r.contacts(p1, p2, out),
             _ => {}
