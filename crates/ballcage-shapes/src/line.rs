@@ -9,10 +9,14 @@
 //! centreline. Its maxima are the ends and the interior points where |u|
 //! stops growing: since u is perpendicular to the centreline at the nearest
 //! point, d|u|²/ds = 2 u·â exactly (â the rod axis), so a maximum lies between
-//! two samples where u·â changes from positive to negative. There regula
-//! falsi (Illinois) on u·â finds it to round-off, so the largest penetration
-//! is exact, and a contact lying wholly between two samples (a straight link
-//! against the convex inner wall of a bend) is not missed.
+//! two samples where u·â changes from positive to negative. There Newton's
+//! method on u·â, with the exact slope d(u·â)/ds and kept in its bracket by
+//! regula falsi (Illinois), finds it to round-off, so the largest
+//! penetration is exact, and a contact lying wholly between two samples (a
+//! straight link against the convex inner wall of a bend) is not missed.
+//! Between the rod's ends the samples and the root finding need only the
+//! axis point ([`Axis`]: one nearest-point query); a flat rod's rim point,
+//! a second query, is found only where a contact is reported.
 //!
 //! Three reductions of the depth along the axis:
 //! - [`line_extrema`]: every depth maximum (ends included) and every
@@ -53,15 +57,11 @@ struct RodInLumen<'a, L: ?Sized> {
     cull: bool,
 }
 
-/// The deepest surface point of one axial station.
+/// The rod's axis point at one axial position against the centreline:
+/// what brackets and finds the extrema of the depth (one nearest-point
+/// query, where the [`Station`] needs a second for a flat rod's rim).
 #[derive(Clone, Copy)]
-struct Station {
-    /// Midpoint between the surfaces [m].
-    point: Vector,
-    /// Unit normal from the wall toward the rod.
-    normal: Vector,
-    /// Penetration [m]; negative for a gap.
-    depth: f64,
+struct Axis {
     /// u·â: positive while the offset from the centreline grows along the axis [m].
     growth: f64,
     /// d(u·â)/ds = 1 − β·(t̂·â)² [–], t̂ the centreline's tangent at the
@@ -71,6 +71,19 @@ struct Station {
     slope: f64,
     /// |u|, the axis point's distance from the centreline [m].
     offset: f64,
+}
+
+/// The deepest surface point of one axial station.
+#[derive(Clone, Copy)]
+struct Station {
+    /// Midpoint between the surfaces [m].
+    point: Vector,
+    /// Unit normal from the wall toward the rod.
+    normal: Vector,
+    /// Penetration [m]; negative for a gap.
+    depth: f64,
+    /// The axis point there.
+    axis: Axis,
 }
 
 impl Station {
@@ -85,19 +98,35 @@ impl Station {
 }
 
 impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
-    /// The station at axial position `s` [m]. `None` where the axis is on
-    /// the centreline or the station is past the lumen's open ends.
-    fn station(&self, s: f64) -> Option<Station> {
+    /// The axis point at axial position `s` [m]: the point q, its offset u
+    /// from the centreline, and what they give. `None` past the lumen's
+    /// open ends.
+    fn axis_at(&self, s: f64) -> Option<(Vector, Vector, Axis)> {
         let q = self.rod.at(s);
         let c = self.lumen.nearest(q)?;
         let u = q - c.point;
-        let growth = u.dot(self.rod.axis);
         let beta = 1.0 / (1.0 - u.dot(c.curvature));
-        let slope = 1.0 - beta * c.tangent.dot(self.rod.axis).powi(2);
+        let axis = Axis {
+            growth: u.dot(self.rod.axis),
+            slope: 1.0 - beta * c.tangent.dot(self.rod.axis).powi(2),
+            offset: u.length(),
+        };
+        Some((q, u, axis))
+    }
+
+    /// [`Self::axis_at`] without the points.
+    fn axis(&self, s: f64) -> Option<Axis> {
+        self.axis_at(s).map(|(.., axis)| axis)
+    }
+
+    /// The station at axial position `s` [m]. `None` where the axis is on
+    /// the centreline or the station is past the lumen's open ends.
+    fn station(&self, s: f64) -> Option<Station> {
+        let (q, u, axis) = self.axis_at(s)?;
         if self.ends == Ends::Round {
-            return self.ball_station(q, u, growth, slope);
+            return self.ball_station(q, u, axis);
         }
-        let across = u - growth * self.rod.axis;
+        let across = u - axis.growth * self.rod.axis;
         let len = across.length();
         if len < 1e-15 {
             return None;
@@ -115,9 +144,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             point: w - 0.5 * depth * out,
             normal: -out,
             depth,
-            growth,
-            slope,
-            offset: u.length(),
+            axis,
         })
     }
 
@@ -132,12 +159,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// their round-off. Skipping such a bracket leaves every contact
     /// reported unchanged, bit for bit: it only spares the root finding
     /// whose result the threshold would drop.
-    fn clear_between(
-        &self,
-        (sa, a): (f64, &Station),
-        (sb, b): (f64, &Station),
-        threshold: f64,
-    ) -> bool {
+    fn clear_between(&self, (sa, a): (f64, &Axis), (sb, b): (f64, &Axis), threshold: f64) -> bool {
         if !self.cull {
             return false;
         }
@@ -147,8 +169,8 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
 
     /// A capsule's station: the sphere about the axis point `q` whose offset
     /// from the centreline is `u`: δ = |u| + r − R.
-    fn ball_station(&self, q: Vector, u: Vector, growth: f64, slope: f64) -> Option<Station> {
-        let len = u.length();
+    fn ball_station(&self, q: Vector, u: Vector, axis: Axis) -> Option<Station> {
+        let len = axis.offset;
         if len < 1e-15 {
             return None;
         }
@@ -159,9 +181,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             point: w - 0.5 * depth * out,
             normal: -out,
             depth,
-            growth,
-            slope,
-            offset: len,
+            axis,
         })
     }
 
@@ -169,16 +189,13 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// and stations) whose growths u·â have the same sign, if u·â changes
     /// sign twice between them: where the slope d(u·â)/ds goes from −
     /// to + under positive growths (u·â dips below zero), or from + to −
-    /// under negative ones. The turn is approached by bisection on the
-    /// slope's sign (the slope jumps where the centreline's curvature does)
-    /// until u·â has crossed zero, then each root of u·â on its side is
+    /// under negative ones. The turn is approached by regula falsi
+    /// (Illinois) on the slope, which keeps a bracket where the slope jumps
+    /// with the centreline's curvature, until u·â has crossed zero, then
+    /// each root of u·â on its side is
     /// found by [`Self::stationary`]. Returns the maximum's and the
     /// minimum's positions [m].
-    fn hidden_pair(
-        &self,
-        (sa, a): (f64, &Station),
-        (sb, b): (f64, &Station),
-    ) -> Option<(f64, f64)> {
+    fn hidden_pair(&self, (sa, a): (f64, &Axis), (sb, b): (f64, &Axis)) -> Option<(f64, f64)> {
         let up = a.growth > 0.0;
         if up != (b.growth > 0.0) {
             return None;
@@ -188,27 +205,43 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         if !(sign * a.slope < 0.0 && sign * b.slope > 0.0) {
             return None;
         }
-        // Bisection toward the turn, stopping at the first point where u·â
+        // Toward the turn (the slope's zero) by the Illinois variant of
+        // regula falsi on the slope, stopping at the first point where u·â
         // has crossed zero: the roots then lie on either side of it.
         let (mut lo, mut hi) = (sa, sb);
+        let (mut slo, mut shi) = (sign * a.slope, sign * b.slope);
         let tolerance = 1e-12 * (1.0 + sa.abs().max(sb.abs()));
         let mut turn = None;
-        while hi - lo > tolerance {
-            let mid = 0.5 * (lo + hi);
-            let st = self.station(mid)?;
+        // Which end moved last: +1 for lo, −1 for hi.
+        let mut side = 0;
+        for _ in 0..200 {
+            if hi - lo <= tolerance {
+                break;
+            }
+            let x = (lo * shi - hi * slo) / (shi - slo);
+            let mid = if x > lo && x < hi { x } else { 0.5 * (lo + hi) };
+            let st = self.axis(mid)?;
             if sign * st.growth < 0.0 {
                 turn = Some((mid, st));
                 break;
             }
             if sign * st.slope < 0.0 {
-                lo = mid;
+                (lo, slo) = (mid, sign * st.slope);
+                if side == 1 {
+                    shi *= 0.5;
+                }
+                side = 1;
             } else {
-                hi = mid;
+                (hi, shi) = (mid, sign * st.slope);
+                if side == -1 {
+                    slo *= 0.5;
+                }
+                side = -1;
             }
         }
         let (lo, turn) = match turn {
             Some(found) => found,
-            None => (lo, self.station(lo)?),
+            None => (lo, self.axis(lo)?),
         };
         if sign * turn.growth >= 0.0 {
             return None;
@@ -227,9 +260,8 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
 
     /// The axial position in `[a, b]` where the offset from the centreline
     /// stops growing (u·â = 0, the depth's maximum), given u·â = `ga` > 0 at
-    /// `a` and `gb` ≤ 0 at `b`: the Illinois variant of regula falsi, which
-    /// converges superlinearly on this smooth root, to 1e-12 of the
-    /// positions. `None` if a station on the way does not exist.
+    /// `a` and `gb` ≤ 0 at `b` ([`Self::stationary`]). `None` if a station
+    /// on the way does not exist.
     fn deepest(&self, a: (f64, f64), b: (f64, f64)) -> Option<f64> {
         self.stationary(a, b, 1.0)
     }
@@ -239,6 +271,14 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// maximum, see [`Self::deepest`]); with `sign` = −1 from non-positive
     /// to positive (a depth minimum). The growths given are multiplied by
     /// `sign`, so `ga` > 0 ≥ `gb` either way.
+    ///
+    /// Newton's method on u·â with its exact slope d(u·â)/ds, which each
+    /// station computes (quadratic: two or three stations from the first
+    /// estimate), kept inside the bracket, which every station narrows: a
+    /// Newton step that leaves the bracket, or does not halve the step
+    /// before it, is replaced by the Illinois variant of regula falsi (the
+    /// slope jumps where the centreline's curvature does). Stops when the
+    /// bracket or the last step is within 1e-12 of the positions.
     fn stationary(
         &self,
         (mut a, mut ga): (f64, f64),
@@ -251,29 +291,41 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
         // Which end moved last: +1 for a, −1 for b.
         let mut side = 0;
+        // The last station: its position, sign·u·â, sign·slope, and the step to it.
+        let mut last: Option<(f64, f64, f64, f64)> = None;
         for _ in 0..100 {
             if b - a <= tolerance {
                 break;
             }
-            let x = (a * gb - b * ga) / (gb - ga);
-            let x = if x > a && x < b { x } else { 0.5 * (a + b) };
-            let gx = sign * self.station(x)?.growth;
+            let newton = last.and_then(|(x, g, slope, step)| {
+                let next = x - g / slope;
+                let fine = slope != 0.0 && next > a && next < b && (next - x).abs() <= 0.5 * step;
+                fine.then_some(next)
+            });
+            let x = newton.unwrap_or_else(|| {
+                let x = (a * gb - b * ga) / (gb - ga);
+                if x > a && x < b { x } else { 0.5 * (a + b) }
+            });
+            let st = self.axis(x)?;
+            let (gx, slope) = (sign * st.growth, sign * st.slope);
+            let step = last.map_or(b - a, |(prev, ..)| (x - prev).abs());
+            if gx == 0.0 || (newton.is_some() && step <= tolerance) {
+                return Some(x);
+            }
             if gx > 0.0 {
                 (a, ga) = (x, gx);
-                if side == 1 {
+                if side == 1 && newton.is_none() {
                     gb *= 0.5;
                 }
                 side = 1;
             } else {
                 (b, gb) = (x, gx);
-                if side == -1 {
+                if side == -1 && newton.is_none() {
                     ga *= 0.5;
                 }
                 side = -1;
             }
-            if gx == 0.0 {
-                return Some(x);
-            }
+            last = Some((x, gx, slope, step));
         }
         Some(if ga.abs() < gb.abs() { a } else { b })
     }
@@ -287,7 +339,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         (sb, b): (f64, &Option<Station>),
         threshold: f64,
     ) -> Option<(f64, Station)> {
-        let (a, b) = (a.as_ref()?, b.as_ref()?);
+        let (a, b) = (&a.as_ref()?.axis, &b.as_ref()?.axis);
         if !(a.growth > 0.0 && b.growth <= 0.0) || self.clear_between((sa, a), (sb, b), threshold) {
             return None;
         }
@@ -565,8 +617,8 @@ impl Extremum {
 /// annihilate with equal and opposite terms.
 ///
 /// The `samples` (≥ 2, ends included) only bracket the extrema: each sign
-/// change of u·â between two samples is refined by regula falsi to 1e-12 of
-/// the positions. A maximum and a minimum born together between the same
+/// change of u·â between two samples is refined by Newton's method
+/// (safeguarded by regula falsi) to 1e-12 of the positions. A maximum and a minimum born together between the same
 /// two samples (where u·â turns back across zero) are found from the sign
 /// change of d(u·â)/ds at the samples (`RodInLumen::hidden_pair`), so a
 /// pair enters with equal depths, as the law needs for continuity. Only
@@ -605,13 +657,22 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
                 emit(st.contact(feature), kind);
             }
         };
-        let mut here = link.station(s(0));
-        let end_zero = here.as_ref().filter(|st| st.growth <= 0.0).copied();
+        // The ends' stations in full (an end is a maximum by itself); in
+        // between the axis points alone bracket the extrema.
+        let first = link.station(s(0));
+        let end_zero = first.filter(|st| st.axis.growth <= 0.0);
         if let Some(st) = end_zero {
             put(st, 0, Extremum::End);
         }
+        let mut here = first.map(|st| st.axis);
+        let mut last = None;
         for k in 0..n - 1 {
-            let next = link.station(s(k + 1));
+            let next = if k + 2 == n {
+                last = link.station(s(k + 1));
+                last.map(|st| st.axis)
+            } else {
+                link.axis(s(k + 1))
+            };
             if let (Some(a), Some(b)) = (&here, &next)
                 && !link.clear_between((s(k), a), (s(k + 1), b), threshold)
             {
@@ -650,7 +711,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             }
             here = next;
         }
-        if let Some(st) = here.filter(|st| st.growth > 0.0) {
+        if let Some(st) = last.filter(|st| st.axis.growth > 0.0) {
             put(st, n - 1, Extremum::End);
         }
     }
