@@ -4,16 +4,20 @@ and ``ballcage paper``."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pyarrow as pa
 
-from ballcage._files import write_parquet, write_png
+from ballcage._files import parquet_writer, write_all_atomically
 from ballcage._native import InputError
 from ballcage._plot import figure, series_styles
 from ballcage.measures.fatigue import fatigue_table, section_stresses
 from ballcage.measures.sections import Section, SectionLoads, link_sections, section_loads
 from ballcage.run import Run
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = ["FATIGUE_FIGURE", "FATIGUE_FILE", "fatigue_markdown", "write_fatigue", "write_fatigue_or_why"]
 
@@ -27,8 +31,13 @@ def write_fatigue(run: Run, out: Path) -> tuple[pa.Table, dict[str, Path]]:
     sections = link_sections(run)
     loads = section_loads(run, sections)
     table = fatigue_table(run, sections, loads)
-    written = {"fatigue": write_parquet(table, out / FATIGUE_FILE)}
-    written["fatigue_figure"] = _write_figure(table, sections, loads, out / FATIGUE_FIGURE)
+    fig = _figure(table, sections, loads)
+    written = {"fatigue": out / FATIGUE_FILE, "fatigue_figure": out / FATIGUE_FIGURE}
+    # both or neither, as the wear map: a run killed while writing them leaves no table without its figure
+    write_all_atomically({
+        written["fatigue"]: parquet_writer(table),
+        written["fatigue_figure"]: lambda tmp: fig.savefig(tmp, format="png", dpi=120),
+    })  # fmt: skip
     return table, written
 
 
@@ -45,7 +54,7 @@ def write_fatigue_or_why(run: Run, out: Path, written: dict[str, Path]) -> pa.Ta
     return table
 
 
-def _write_figure(table: pa.Table, sections: list[Section], loads: SectionLoads, path: Path) -> Path:
+def _figure(table: pa.Table, sections: list[Section], loads: SectionLoads) -> Figure:
     """Left: hours to failure per link and section; right: the shortest-lived section's stress history."""
     rows = table.to_pylist()
     fig = figure(figsize=(12.0, 4.6))
@@ -81,7 +90,7 @@ def _write_figure(table: pa.Table, sections: list[Section], loads: SectionLoads,
         right.legend(loc="best", fontsize="small")
     right.set_xlabel("t [s]")
     right.set_ylabel("stress [MPa]")
-    return write_png(fig, path)
+    return fig
 
 
 def fatigue_markdown(table: pa.Table | str) -> str:
