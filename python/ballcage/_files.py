@@ -114,9 +114,18 @@ def write_parquet(table: pa.Table, path: Path) -> Path:
     return path
 
 
+def png_writer(figure: Figure, dpi: int = 120) -> Callable[[Path], None]:
+    """The one PNG writer of `figure` at `dpi` dots per inch: fills the path it is given, for `write_atomically`."""
+
+    def write(tmp: Path) -> None:
+        figure.savefig(tmp, format="png", dpi=dpi)
+
+    return write
+
+
 def write_png(figure: Figure, path: Path, dpi: int = 120) -> Path:
-    """Renders `figure` to `path` as PNG at `dpi` dots per inch, atomically; returns `path`."""
-    write_atomically(path, lambda tmp: figure.savefig(tmp, format="png", dpi=dpi))
+    """Renders `figure` to `path` as PNG at `dpi` dots per inch (`png_writer`), atomically; returns `path`."""
+    write_atomically(path, png_writer(figure, dpi))
     return path
 
 

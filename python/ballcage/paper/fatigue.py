@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pyarrow as pa
 
-from ballcage._files import parquet_writer, write_all_atomically
+from ballcage._files import parquet_writer, png_writer, write_all_atomically
 from ballcage._native import InputError
 from ballcage._plot import figure, series_styles
 from ballcage.measures.fatigue import fatigue_table, section_stresses
@@ -36,7 +36,7 @@ def write_fatigue(run: Run, out: Path) -> tuple[pa.Table, dict[str, Path]]:
     # both or neither, as the wear map: a run killed while writing them leaves no table without its figure
     write_all_atomically({
         written["fatigue"]: parquet_writer(table),
-        written["fatigue_figure"]: lambda tmp: fig.savefig(tmp, format="png", dpi=120),
+        written["fatigue_figure"]: png_writer(fig),
     })  # fmt: skip
     return table, written
 

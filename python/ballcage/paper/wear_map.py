@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from ballcage._files import parquet_writer, write_all_atomically
+from ballcage._files import parquet_writer, png_writer, write_all_atomically
 from ballcage.measures.wear_map import deepest, hours_line, wear_map
 from ballcage.run import Run
 from ballcage.view.wear import WEAR_FIGURE_FILE, WEAR_MAP_FILE, wear_figure
@@ -24,7 +24,7 @@ def write_wear_map(run: Run, out: Path) -> tuple[pa.Table, dict[str, Path]]:
     # both or neither: a run killed while writing them leaves no map without its figure
     write_all_atomically({
         paths["wear_map"]: parquet_writer(table),
-        paths["wear_map_figure"]: lambda tmp: figure.savefig(tmp, format="png", dpi=120),
+        paths["wear_map_figure"]: png_writer(figure),
     })  # fmt: skip
     return table, paths
 
