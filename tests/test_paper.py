@@ -47,7 +47,7 @@ FIGURES = [
 ]
 EXPECTED_FILES = sorted(
     [f"{t}.parquet" for t in TABLES]
-    + ["scene.toml", *FIGURES, *DERIVED, "chain.html", "comparison.parquet", "comparison.md"]
+    + ["scene.toml", *FIGURES, *DERIVED, "chain.html", "comparison.parquet", "comparison.md", "verify.parquet"]
 )
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 #: Radial play of a link centre in the guide tube (58 mm bore, 43 mm link radius) plus 1 mm of penetration.
@@ -101,7 +101,9 @@ def short_run():
 def test_paper_writes_every_table_figure_and_comparison(paper_out):
     out, proc = paper_out
     assert sorted(p.name for p in out.iterdir()) == EXPECTED_FILES
-    assert len(proc.stdout.splitlines()) == len(EXPECTED_FILES)  # one "wrote ..." line per file
+    lines = proc.stdout.splitlines()
+    assert len(lines) == len(EXPECTED_FILES) + 1  # one "wrote ..." line per file, then the verification's
+    assert lines[-1].startswith("ballcage: error ≤ ") and "(verified at rtol/10: " in lines[-1], lines[-1]
     for name in TABLES:
         assert pq.read_table(out / f"{name}.parquet").num_rows > 0, name
     assert tomllib.loads((out / "scene.toml").read_text(encoding="utf-8"))["simulation"]["duration"] == 0.01
@@ -118,7 +120,7 @@ def test_figures_are_real_pngs_of_nontrivial_size(paper_out, figure):
 def test_comparison_has_exactly_the_reference_keys_columns_and_types(paper_out):
     out, _ = paper_out
     table = pq.read_table(out / "comparison.parquet")
-    assert table.column_names == ["key", "paper", "ours", "unit", "ratio", "note"]
+    assert table.column_names == ["key", "paper", "ours", "unit", "ratio", "note", "numerical_error", "numerical_error_rel"]
     types = {f.name: f.type for f in table.schema}
     assert types == {
         "key": pa.string(),
@@ -127,6 +129,8 @@ def test_comparison_has_exactly_the_reference_keys_columns_and_types(paper_out):
         "unit": pa.string(),
         "ratio": pa.float64(),
         "note": pa.string(),
+        "numerical_error": pa.float64(),
+        "numerical_error_rel": pa.float64(),
     }
     shipped = _reference_quantities()
     expected = _expected_rows()
@@ -171,7 +175,7 @@ def test_comparison_markdown_has_title_command_and_one_row_per_key(paper_out):
     lines = text.splitlines()
     assert lines[0].startswith("# ")
     assert f"ballcage paper --out {out} --set simulation.duration=0.01" in text
-    assert "| key | paper | ours | unit | ratio | note |" in lines
+    assert "| key | paper | ours | unit | ratio | numerical error | note |" in lines
     for key, _, _ in _expected_rows():
         assert sum(line.startswith(f"| {key} |") for line in lines) == 1, key
     # The paper gives no cage-head value: an empty paper cell and ratio, our value filled.
@@ -187,6 +191,65 @@ def test_python_api_comparison_matches_the_cli(paper_out, short_run):
     assert api.select(["key", "paper", "ours", "unit", "ratio"]).equals(
         cli.select(["key", "paper", "ours", "unit", "ratio"])
     )
+
+
+def test_each_row_s_numerical_error_is_its_difference_to_the_run_ten_times_tighter(tmp_path):
+    # Long enough for the links to reach the tube and the keys to load, so that the errors are not all zero.
+    out, duration = tmp_path / "p", ["simulation.duration=0.05"]
+    proc = _cli("paper", "--out", str(out), "--set", duration[0])
+    assert proc.returncode == 0, proc.stderr
+    rows = pq.read_table(out / "comparison.parquet").to_pylist()
+    # By hand: the same scene at rtol 1e-4 (the default) and at 1e-5, each compared with the paper on its own.
+    run = paper.comparison(ballcage.simulate(paper.paper_scene(duration), progress=False))
+    tight = paper.comparison(ballcage.simulate(paper.paper_scene([*duration, "simulation.rtol=1e-05"]), progress=False))
+    floors = {"N": 1.0, "deg": 0.1, "mm": 1.0}
+    moved = 0
+    for row, a, b in zip(rows, run.to_pylist(), tight.to_pylist(), strict=True):
+        key = row["key"]
+        assert row["ours"] == a["ours"], key
+        if key.startswith("sweep_"):  # the section-4 cases are not rerun
+            assert row["numerical_error"] is None and row["numerical_error_rel"] is None, key
+            continue
+        assert row["numerical_error"] == abs(a["ours"] - b["ours"]), key
+        if key == "most_deformed_joint":  # an index: no relative difference
+            assert row["numerical_error_rel"] is None
+        else:
+            rel = abs(a["ours"] - b["ours"]) / max(abs(b["ours"]), floors[row["unit"]])
+            assert row["numerical_error_rel"] == pytest.approx(rel, rel=1e-12, abs=0.0), key
+        moved += row["numerical_error"] > 0.0
+    assert moved >= 10  # the tighter run differs: the column measures something
+    text = (out / "comparison.md").read_text(encoding="utf-8")
+    largest = max((r["numerical_error_rel"], r["key"]) for r in rows if r["numerical_error_rel"] is not None)
+    assert f"on `{largest[1]}`" in text and "Numerical error: each row's |ours − ours of the same run" in text
+
+
+def test_paper_without_verification_leaves_the_column_empty_and_says_so(tmp_path):
+    out = tmp_path / "p"
+    (out).mkdir()
+    (out / "verify.parquet").write_bytes(b"an earlier run's")
+    proc = _cli("paper", "--out", str(out), "--set", "simulation.duration=0.01", "--no-verify")
+    assert proc.returncode == 0, proc.stderr
+    assert not (out / "verify.parquet").exists()  # the earlier run's would be taken for this run's
+    table = pq.read_table(out / "comparison.parquet")
+    assert table.column("numerical_error").null_count == table.num_rows
+    text = (out / "comparison.md").read_text(encoding="utf-8")
+    assert "**Numerical error: not measured (--no-verify).**" in text and " --no-verify" in text.split("```")[1]
+    assert "error ≤" not in proc.stdout
+
+
+def test_a_failed_verification_leaves_a_complete_report_without_the_column_and_exits_1(tmp_path):
+    # SDIRK2's 100 steps fit simulation.max_steps = 200, the verification run's 400 (dt/4) do not.
+    out = tmp_path / "p"
+    fixed = ['simulation.integrator="sdirk2"', "simulation.rtol=0", "simulation.max_steps=200"]
+    proc = _cli("paper", "--out", str(out), "--set", "simulation.duration=0.01", *[a for o in fixed for a in ("--set", o)])
+    assert proc.returncode == 1
+    last = proc.stderr.strip().splitlines()[-1]
+    assert last.startswith("ballcage: error: the verification run at dt/4 failed: "), last
+    assert "simulation.max_steps" in last and "complete without the numerical error column" in last
+    assert sorted(p.name for p in out.iterdir()) == [f for f in EXPECTED_FILES if f != "verify.parquet"]
+    table = pq.read_table(out / "comparison.parquet")
+    assert table.column("numerical_error").null_count == table.num_rows
+    assert "**Numerical error: the verification run at dt/4 failed: " in (out / "comparison.md").read_text()
 
 
 def test_comparison_fills_sweep_rows_from_given_runs(short_run):

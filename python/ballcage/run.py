@@ -36,7 +36,7 @@ from ballcage.scene import SceneSource, load_scene
 if TYPE_CHECKING:
     import pyarrow as pa
 
-__all__ = ["VERIFY_FILE", "Run", "TimeLimitError", "Verification", "simulate"]
+__all__ = ["VERIFY_FILE", "Run", "TimeLimitError", "Verification", "VerificationError", "simulate"]
 
 #: Number of `advance` calls a run is split into.
 CHUNKS = 200
@@ -67,6 +67,18 @@ class Verification:
     quantity: str | None
     #: Wall time of the verification run over the run's (``ballcage.wall_time_s``); ``None`` if not measured.
     time_ratio: float | None
+
+
+class VerificationError(_native.SimulationError):
+    """The verification run failed (it diverged, or its scene was refused, e.g. by ``simulation.max_steps``).
+
+    ``e.run`` is the run that was being verified, complete but without a
+    verification; ``e.check`` what the verification run recorded up to its
+    failure (``None`` when it did not start).
+    """
+
+    run: Run
+    check: Run | None
 
 
 class TimeLimitError(_native.Error, TimeoutError):
@@ -272,7 +284,7 @@ def simulate(
     ``e.run.write(dir)`` writes it like a complete run. An interrupt
     (Ctrl-C, `KeyboardInterrupt`) is re-raised the same way, carrying the
     frames recorded so far as ``e.run`` (``Run.error`` says when it stopped).
-    When the verification run fails, `ballcage.verify.VerificationError` (a
+    When the verification run fails, `VerificationError` (a
     `SimulationError`) carries the complete run, unverified, as ``e.run``; an
     interrupt during the verification run carries it too.
 

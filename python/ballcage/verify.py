@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
-from ballcage.run import Run, Verification, simulate
+from ballcage.run import Run, Verification, VerificationError, simulate
 from ballcage.studies.refinement import TIGHTER, Tighter, tighter
 
 if TYPE_CHECKING:
@@ -45,6 +45,7 @@ __all__ = [
     "headline",
     "tighter",
     "verdict",
+    "verification_of",
     "verify",
 ]
 
@@ -68,18 +69,6 @@ COLUMNS: dict[str, tuple[str, str, str]] = {
               "null for a unit without one"),
     "note": ("string", "", "why rel_difference is null, or how the runs compare where it cannot say"),
 }  # fmt: skip
-
-
-class VerificationError(_native.SimulationError):
-    """The verification run failed (it diverged, or its scene was refused, e.g. by ``simulation.max_steps``).
-
-    ``e.run`` is the run that was being verified, complete but without a
-    verification; ``e.check`` what the verification run recorded up to its
-    failure (``None`` when it did not start).
-    """
-
-    run: Run
-    check: Run | None
 
 
 def verify(run: Run, *, progress: bool | None = None) -> Verification:
@@ -127,6 +116,23 @@ def verify(run: Run, *, progress: bool | None = None) -> Verification:
         "ballcage.verify.largest_quantity": quantity or "",
     }
     return Verification(table.replace_schema_metadata(meta), setting.label, setting.overrides, largest, quantity, ratio)
+
+
+def verification_of(table: pa.Table) -> Verification:
+    """The `Verification` a ``verify.parquet`` table (read back, e.g. by ``pyarrow.parquet.read_table``) holds.
+
+    Its setting, overrides, largest difference and time ratio come from the
+    schema metadata `verify` writes.
+    """
+    meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
+    return Verification(
+        table,
+        meta.get("ballcage.verify.setting", ""),
+        tuple(json.loads(meta.get("ballcage.verify.overrides") or "[]")),
+        _float(meta.get("ballcage.verify.largest_relative")),
+        meta.get("ballcage.verify.largest_quantity") or None,
+        _float(meta.get("ballcage.verify.time_ratio")),
+    )
 
 
 def headline(run: Run) -> dict[str, tuple[str, float | None]]:

@@ -171,6 +171,9 @@ pub struct Dynamics {
     force: Vec<Vec3>,
     torque: Vec<Vec3>,
     points: Vec<ContactPoint>,
+    /// Each body's angular velocity in the world frame at the state being
+    /// evaluated [rad/s]: rotated once per body, not once per pair.
+    omega_world: Vec<Vec3>,
     /// Per pair: its points of the current evaluation.
     pairs: Vec<PairEval>,
     /// Threads that evaluate the pairs (`None`: this thread alone).
@@ -291,6 +294,7 @@ impl Dynamics {
             force: vec![Vec3::zeros(); n],
             torque: vec![Vec3::zeros(); n],
             points: Vec::with_capacity(16),
+            omega_world: vec![Vec3::zeros(); n],
             // Room for as many points as each pair can report: no
             // allocation when a pair first comes into contact.
             pairs: model
@@ -383,6 +387,7 @@ impl Dynamics {
                 Vec3::zeros()
             };
             self.torque[i] = Vec3::zeros();
+            self.omega_world[i] = state.omega_world(i);
         }
         for l in &model.torques {
             self.torque[l.body] += l.torque(state.t);
@@ -418,8 +423,9 @@ impl Dynamics {
     ) {
         let n = model.pairs.len();
         let scale = jac.as_ref().map_or(0.0, |j| j.stiffness_scale);
+        let omega = &self.omega_world;
         let one = |k: usize, e: &mut PairEval, l: &mut Vec<Option<f64>>, c| {
-            evaluate_pair(model, state, mode, k, e, l, c, scale)
+            evaluate_pair(model, (state, omega), mode, k, e, l, c, scale)
         };
         let (pairs, latched) = (&mut self.pairs, &mut self.latched);
         // A few tasks per thread: enough to balance, few enough to be cheap.
@@ -614,7 +620,7 @@ pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -
 #[allow(clippy::too_many_arguments)]
 fn evaluate_pair(
     model: &Model,
-    state: &State,
+    (state, omega_world): (&State, &[Vec3]),
     mode: Mode,
     k: usize,
     e: &mut PairEval,
@@ -632,7 +638,7 @@ fn evaluate_pair(
         }
         return;
     }
-    let motion = PairMotion::of(state, pair);
+    let motion = PairMotion::of(state, pair, |i| omega_world[i]);
     if mode == Mode::Commit {
         latch(latched, &motion, &e.points);
     }
@@ -703,8 +709,10 @@ struct PairMotion {
 }
 
 impl PairMotion {
-    fn of(state: &State, pair: &ContactPair) -> Self {
-        let body = |i: usize| (state.vel[i], state.omega_world(i), state.pos[i]);
+    /// The motion of `pair`'s bodies at `state`, `omega_world` giving body
+    /// i's angular velocity in the world frame.
+    fn of(state: &State, pair: &ContactPair, omega_world: impl Fn(usize) -> Vec3) -> Self {
+        let body = |i: usize| (state.vel[i], omega_world(i), state.pos[i]);
         Self {
             a: body(pair.a),
             b: body(pair.b),
@@ -726,7 +734,7 @@ fn evaluate_point(
     p: &ContactPoint,
     latched: &[Option<f64>],
 ) -> ContactEval {
-    let motion = PairMotion::of(state, pair);
+    let motion = PairMotion::of(state, pair, |i| state.omega_world(i));
     ContactEval::new(*p, &evaluate_point_full(&motion, pair, p, latched).0)
 }
 
@@ -819,10 +827,11 @@ impl CouplingJacobian {
     /// to a's.
     fn add_gradient(&mut self, g: &Mat3, r_a: &Vec3, r_b: &Vec3) {
         self.active = true;
-        self.bb += wrench_twist_block(r_b, g, r_b);
-        self.ba -= wrench_twist_block(r_b, g, r_a);
-        self.ab -= wrench_twist_block(r_a, g, r_b);
-        self.aa += wrench_twist_block(r_a, g, r_a);
+        let [bb, ba, ab, aa] = wrench_twist_blocks(r_b, g, r_a);
+        self.bb += bb;
+        self.ba -= ba;
+        self.ab -= ab;
+        self.aa += aa;
     }
 
     /// Adds contact point `e` of `pair` (stiffness weight `scale`).
@@ -876,10 +885,8 @@ impl CouplingJacobian {
         let f = s * sigma * e.normal_force;
         let (rp, rq) = (t.centre - state.pos[p], t.centre - state.pos[q]);
         let g = f * t.curvature;
-        let mut pp = wrench_twist_block(&rp, &g, &rp);
-        let mut pq = -wrench_twist_block(&rp, &g, &rq);
-        let mut qp = -wrench_twist_block(&rq, &g, &rp);
-        let mut qq = wrench_twist_block(&rq, &g, &rq);
+        let [mut pp, pq, qp, mut qq] = wrench_twist_blocks(&rp, &g, &rq);
+        let (mut pq, mut qp) = (-pq, -qp);
         // The field turning with Q: δF_P = −f·[n̂]×·δθ_Q.
         let turn = -f * n.cross_matrix();
         let (rpx, rqx) = (rp.cross_matrix(), rq.cross_matrix());
@@ -1175,16 +1182,29 @@ fn add3(to: &mut Mat6, row: usize, col: usize, m: &Mat3) {
     v += m;
 }
 
-/// W_i·G·J_j: the wrench on body i (force G·u at arm r_i) per unit twist of
-/// body j (u the velocity of j's point at arm r_j). With `R = [r]×`:
-/// `[[G, −G·R_j], [R_i·G, −R_i·G·R_j]]`.
-fn wrench_twist_block(r_i: &Vec3, g: &Mat3, r_j: &Vec3) -> Mat6 {
-    let ri = r_i.cross_matrix();
-    let g_rj = g * r_j.cross_matrix();
+/// W_i·G·J_j for the four pairs (i, j) of two arms `r_p` and `r_q`,
+/// [PP, PQ, QP, QQ]: the wrench on body i (force G·u at arm r_i) per unit
+/// twist of body j (u the velocity of j's point at arm r_j). With
+/// `R = [r]×`, each is `[[G, −G·R_j], [R_i·G, −R_i·G·R_j]]`; the products
+/// G·R and R·G are formed once for the four.
+fn wrench_twist_blocks(r_p: &Vec3, g: &Mat3, r_q: &Vec3) -> [Mat6; 4] {
+    let (rp, rq) = (r_p.cross_matrix(), r_q.cross_matrix());
+    let (g_rp, g_rq) = (g * rp, g * rq);
+    let (rp_g, rq_g) = (rp * g, rq * g);
+    [
+        block(g, &(-g_rp), &rp_g, &(-(rp * g_rp))),
+        block(g, &(-g_rq), &rp_g, &(-(rp * g_rq))),
+        block(g, &(-g_rp), &rq_g, &(-(rq * g_rp))),
+        block(g, &(-g_rq), &rq_g, &(-(rq * g_rq))),
+    ]
+}
+
+/// The 6×6 block [[a, b], [c, d]] of four 3×3 blocks.
+fn block(a: &Mat3, b: &Mat3, c: &Mat3, d: &Mat3) -> Mat6 {
     let mut m = Mat6::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(g);
-    m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_rj));
-    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(ri * g));
-    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&(-(ri * g_rj)));
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(a);
+    m.fixed_view_mut::<3, 3>(0, 3).copy_from(b);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(c);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(d);
     m
 }

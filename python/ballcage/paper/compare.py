@@ -42,10 +42,12 @@ from ballcage.paper.places import distribution_row, key_place_text, link12_text
 from ballcage.run import Run
 
 if TYPE_CHECKING:
+    from ballcage.run import Verification
     from ballcage.studies.sensitivity_report import Spread
 
 __all__ = [
     "COMPARISON_SCHEMA",
+    "ERROR_FIELDS",
     "PHASES_KEY",
     "SPREAD_FIELDS",
     "PhaseListing",
@@ -53,6 +55,7 @@ __all__ = [
     "fmt",
     "phase_listing",
     "sensitivity_quantity",
+    "with_numerical_error",
     "with_spread",
 ]
 
@@ -85,6 +88,14 @@ SPREAD_FIELDS: dict[str, tuple[pa.DataType, str]] = {
                         "null when none moves it or the study has no such quantity"),
     "spread_dominant_below_error": (pa.bool_(), "the dominant parameter's effect is below the study's numerical "
                                     "error; null without an estimate"),
+}  # fmt: skip
+#: The columns `with_numerical_error` adds: name -> (Arrow type, unit, description).
+ERROR_FIELDS: dict[str, tuple[pa.DataType, str, str]] = {
+    "numerical_error": (pa.float64(), "see unit", "the run's measured numerical error of ours: |ours - ours of the "
+                        "same run repeated ten times tighter| (ballcage run --verify's setting and rule, verify.parquet; "
+                        "unit as unit); null where not verified (a sweep row, or --no-verify)"),
+    "numerical_error_rel": (pa.float64(), "1", "numerical_error / max(|ours of the tighter run|, the unit's floor) "
+                            "(verify.parquet's rel_difference); null where numerical_error is, and for an index"),
 }  # fmt: skip
 
 
@@ -412,7 +423,8 @@ def _sweep_value(run: Run, variant: str, what: str) -> _Value:
 
 
 def sensitivity_quantity(key: str) -> str | None:
-    """The quantity of a sensitivity study (`ballcage.studies.sensitivity_run`) that comparison row `key` is.
+    """The quantity of a sensitivity study (`ballcage.studies.sensitivity_run`) and of a run's verification
+    (`ballcage.verify.headline`) that comparison row `key` is.
 
     The same name (the comparison and the sweep plug-in share their
     quantities), except the paper's per-joint tube forces, which are our
@@ -448,6 +460,33 @@ def with_spread(table: pa.Table, spreads: Mapping[str, Spread], meta: Mapping[st
     for name, (kind, description) in SPREAD_FIELDS.items():
         field = pa.field(name, kind, metadata={"description": description, "unit": "see unit" if kind == pa.float64() else ""})
         table = table.append_column(field, pa.array(columns[name], type=kind))
+    return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
+
+
+def with_numerical_error(table: pa.Table, verification: Verification | None) -> pa.Table:
+    """The comparison `table` with each row's measured numerical error from the run's `verification`: `ERROR_FIELDS`.
+
+    A row takes the difference ``verify.parquet`` holds for the quantity
+    `sensitivity_quantity` names when their units agree; null where none
+    does (a sweep row: the section-4 cases are not rerun) and for every row
+    without a `verification`. The verification's setting goes into the
+    schema metadata (``ballcage.verify.setting``, ``ballcage.verify.overrides``).
+    """
+    rows = {r["quantity"]: r for r in verification.table.to_pylist()} if verification is not None else {}
+    columns: dict[str, list[float | None]] = {name: [] for name in ERROR_FIELDS}
+    for row in table.select(["key", "unit"]).to_pylist():
+        name = sensitivity_quantity(row["key"])
+        found = rows.get(name) if name is not None else None
+        if found is not None and _plain_unit(found["unit"] or "") != _plain_unit(row["unit"] or ""):
+            found = None
+        columns["numerical_error"].append(found["abs_difference"] if found is not None else None)
+        columns["numerical_error_rel"].append(found["rel_difference"] if found is not None else None)
+    for name, (kind, unit, description) in ERROR_FIELDS.items():
+        field = pa.field(name, kind, metadata={"description": description, "unit": unit})
+        table = table.append_column(field, pa.array(columns[name], type=kind))
+    if verification is None:
+        return table
+    meta = {"ballcage.verify.setting": verification.setting, "ballcage.verify.overrides": json.dumps(verification.overrides)}
     return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
 
 

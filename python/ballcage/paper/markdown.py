@@ -24,9 +24,14 @@ def comparison_markdown(
     run: Run | None = None,
     sweep_runs: Mapping[str, Run] | None = None,
     section4: tuple[pa.Table, pa.Table] | None = None,
+    unverified: str | None = None,
 ) -> str:
     """``comparison.md``: a title, the command line, a short paragraph, the table and, with `section4`
-    (the sweep's summary and `ballcage.paper.trends.trend_table`), its cases and the paper's trends checked."""
+    (the sweep's summary and `ballcage.paper.trends.trend_table`), its cases and the paper's trends checked.
+
+    With the columns of `ballcage.paper.compare.with_numerical_error` the table shows each row's measured
+    numerical error, and a paragraph says how it was measured; `unverified` says why it was not (the
+    verification run failed, or ``--no-verify``)."""
     duration = ""
     if run is not None:
         facts = scene_facts(run)
@@ -52,12 +57,16 @@ def comparison_markdown(
             + (f"Section-4 cases with reference values: {swept}." if swept else "Sweep rows need `--sweeps`.")
         ),
     ]
+    errors = "numerical_error" in table.column_names
+    if errors:
+        lines += ["", _error_paragraph(table, run, unverified)]
     spread = "spread_min" in table.column_names
     if spread:
         lines += ["", _spread_paragraph(table)]
     extra = ("spread over unstated parameters | dominant parameter | ", "--- | --- | ") if spread else ("", "")
-    header = f"| key | paper | ours | unit | ratio | {extra[0]}note |"
-    lines += ["", header, f"| --- | ---: | ---: | --- | ---: | {extra[1]}--- |"]
+    error = ("numerical error | ", "---: | ") if errors else ("", "")
+    header = f"| key | paper | ours | unit | ratio | {error[0]}{extra[0]}note |"
+    lines += ["", header, f"| --- | ---: | ---: | --- | ---: | {error[1]}{extra[1]}--- |"]
     phases = json.loads((table.schema.metadata or {}).get(PHASES_KEY.encode(), b"{}"))
     for r in table.to_pylist():
         paper = "" if r["paper"] is None else fmt(r["paper"])
@@ -67,7 +76,7 @@ def comparison_markdown(
         if phases.get("note"):
             note = note.replace(phases["note"], "phases: listed under the table")
         note = note.replace("|", "\\|")
-        cells = _spread_cells(r) if spread else ""
+        cells = (_error_cell(r) if errors else "") + (_spread_cells(r) if spread else "")
         lines.append(f"| {r['key']} | {paper} | {ours} | {r['unit']} | {ratio} | {cells}{note} |")
     if run is not None and run.fallback_note is not None:
         lines[lines.index(header)] = f"**Warning: {run.fallback_note}.**\n\n{header}"
@@ -81,6 +90,41 @@ def comparison_markdown(
 
         lines += trend_markdown(*section4)
     return "\n".join(lines) + "\n"
+
+
+def _error_cell(row: Mapping[str, Any]) -> str:
+    """A row's numerical-error cell: relative in per cent, an index's difference as a count, "—" where not verified."""
+    rel, difference = row["numerical_error_rel"], row["numerical_error"]
+    if rel is not None:
+        return f"{fmt(100.0 * rel, 2)} % | "
+    if difference is None:
+        return "— | "
+    if row["unit"] in ("", "1", None):  # an index: the runs agree or name another part
+        return "0 | " if difference == 0 else f"another part, {fmt(difference)} apart | "
+    return f"{fmt(difference)} {row['unit']} | "
+
+
+def _error_paragraph(table: pa.Table, run: Run | None, unverified: str | None) -> str:
+    """How the numerical-error column was measured, and its largest value; or why it is empty."""
+    if unverified is not None:
+        return f"**Numerical error: {unverified}.** The numerical error column is empty."
+    meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()}
+    verification = run.verification if run is not None else None
+    rows = [(r["numerical_error_rel"], r["key"]) for r in table.to_pylist() if r["numerical_error_rel"] is not None]
+    largest = max(rows) if rows else None
+    text = (
+        "Numerical error: each row's |ours − ours of the same run repeated ten times tighter| "
+        f"(at {meta.get('ballcage.verify.setting', '?')}: {', '.join(json.loads(meta.get('ballcage.verify.overrides', '[]')))}; "
+        "the rule of `ballcage run --verify`, both values in `verify.parquet`), relative to the tighter run's value "
+        "or the unit's floor (1 N, 0.1 deg, 1 mm). It is this run's measured error, not an assumed one; the "
+        "sweep rows are not verified (their cases are not rerun). "
+    )
+    if largest is not None:
+        text += f"The largest: {fmt(100.0 * largest[0], 2)} % on `{largest[1]}`"
+        if verification is not None and verification.time_ratio is not None:
+            text += f"; the verification took {fmt(verification.time_ratio, 2)}× the run's time"
+        text += "."
+    return text
 
 
 def _spread_cells(row: Mapping[str, Any]) -> str:

@@ -12,12 +12,12 @@ from typing import TYPE_CHECKING, Any
 from ballcage import _native
 from ballcage._files import write_parquet, write_text
 from ballcage.duty import write_loss_figure
-from ballcage.paper.compare import comparison, with_spread
+from ballcage.paper.compare import comparison, with_numerical_error, with_spread
 from ballcage.paper.fatigue import fatigue_markdown, write_fatigue_or_why
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.paper.wear_map import wear_map_markdown, write_wear_map
-from ballcage.run import simulate
+from ballcage.run import Run, VerificationError, simulate
 from ballcage.scene import default_scene, override_list
 from ballcage.view import write_view
 
@@ -49,6 +49,7 @@ def run_paper(
     workers: int | None = None,
     client: Any = None,
     sensitivity: str | os.PathLike[str] | None = None,
+    verify: bool = True,
 ) -> dict[str, Path]:
     """Runs the paper scene and writes tables, figures and the comparison into `out_dir`.
 
@@ -65,21 +66,21 @@ def run_paper(
     ``fig17_speed.png``, and ``trends.parquet`` checks each ``[[trend]]`` of
     the reference file, also listed in ``comparison.md``.
 
-    Returns the written paths: one per table (``"bodies"``, …), ``"scene"``,
-    one per figure (``"fig09_included_angles"``, …), ``"losses"`` (``losses.png``,
-    the friction loss by contact, `ballcage.duty`), ``"fatigue"`` and ``"fatigue_figure"`` (``fatigue.parquet``,
-    ``fatigue.png``: life at the links' critical sections, `ballcage.measures.fatigue`), ``"wear_map"`` and
-    ``"wear_map_figure"`` (``wear_map.parquet``, ``wear_map.png``: Archard depth per surface cell,
-    `ballcage.measures.wear_map`), ``"view"`` (``chain.html``,
-    the chain turning in 3D, `ballcage.view`), ``"comparison"``,
-    ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder),
-    ``"fig16_curvature"``, ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``.
+    Returns the written paths: one per table (``"bodies"``, …), ``"scene"``, one per figure
+    (``"fig09_included_angles"``, …), ``"losses"`` (``losses.png``, `ballcage.duty`), ``"fatigue"`` and
+    ``"fatigue_figure"`` (`ballcage.measures.fatigue`), ``"wear_map"`` and ``"wear_map_figure"``
+    (`ballcage.measures.wear_map`), ``"view"`` (``chain.html``, `ballcage.view`), ``"verify"``, ``"comparison"``,
+    ``"comparison_md"`` and, with `sweeps`, ``"sweeps"`` (the sweep folder), ``"fig16_curvature"``,
+    ``"fig17_speed"``, ``"losses_curvature"`` and ``"trends"``.
 
-    With a sensitivity study (`sensitivity`, the path of its ``sensitivity.parquet``;
-    default ``out_dir/sensitivity.parquet`` when it exists, `find_sensitivity`),
-    every comparison row gains the range of its quantity over the study's runs
-    and the parameter with the largest effect (`ballcage.paper.compare.with_spread`;
-    null, "—" in ``comparison.md``, where the study has no such quantity). Raises
+    With a sensitivity study (`sensitivity`, the path of its ``sensitivity.parquet``; default
+    ``out_dir/sensitivity.parquet`` when it exists, `find_sensitivity`), every comparison row gains the range of
+    its quantity over the study's runs and the parameter with the largest effect
+    (`ballcage.paper.compare.with_spread`; null, "—" in ``comparison.md``, where the study has no such quantity).
+
+    With `verify` the run is repeated ten times tighter (as ``ballcage run --verify``) and every row gains its
+    measured numerical error (`ballcage.paper.compare.with_numerical_error`). If that run fails, the rest is
+    written and its `ballcage.run.VerificationError` raised last, the written paths as ``e.written``. Raises
     `ballcage.SceneError` for an invalid override, `ballcage.InputError` for a
     sensitivity table that cannot be read, and `ballcage.SimulationError`
     when the main run diverges (a sweep case that diverges is recorded in the
@@ -95,31 +96,49 @@ def run_paper(
     spec = section4_spec(user) if sweeps else None
     if spec is not None:
         spec.check()
-    run = simulate(main_scene, progress=progress)
+    run, failure = _main_run(main_scene, progress, verify)
     written = run.write(out)
+    derived = _write_derived(run, out, written)
+    section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
+    sweep_runs = section4[0].variant_runs() if section4 is not None else None
+    table = with_numerical_error(comparison(run, sweep_runs), run.verification)
+    if spread is not None:
+        table = with_spread(table, *spread)
+    written["comparison"] = write_parquet(table, out / "comparison.parquet")
+    md = comparison_markdown(
+        table,
+        command=_command_line(out, user, sweeps, sensitivity, verify),
+        run=run,
+        sweep_runs=sweep_runs,
+        section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
+        unverified=str(failure) if failure is not None else None if verify else "not measured (--no-verify)",
+    )
+    written["comparison_md"] = write_text(md + derived, out / "comparison.md")
+    if failure is not None:
+        failure.written = written  # type: ignore[attr-defined]
+        raise failure
+    return written
+
+
+def _main_run(scene: _native.Scene, progress: bool | None, verify: bool) -> tuple[Run, VerificationError | None]:
+    """The paper run, verified with `verify`; a failed verification is returned beside the complete run."""
+    try:
+        return simulate(scene, progress=progress, verify=verify), None
+    except VerificationError as e:
+        return e.run, e
+
+
+def _write_derived(run: Run, out: Path, written: dict[str, Path]) -> str:
+    """The figures, loss figure, fatigue table, wear map and 3D view of `run` into `out` (and `written`); returns
+    the Markdown of the wear map and fatigue table for ``comparison.md``."""
     written.update(write_figures(run, out))
     written["losses"] = write_loss_figure(run.tables["wear"], out / LOSS_FILE)
     fatigue = write_fatigue_or_why(run, out, written)
     wear_map, wear_paths = write_wear_map(run, out)
     written.update(wear_paths)
     written["view"] = write_view(run, out / VIEW_FILE, frames=VIEW_FRAMES)
-    section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
-    sweep_runs = section4[0].variant_runs() if section4 is not None else None
-    table = comparison(run, sweep_runs)
-    if spread is not None:
-        table = with_spread(table, *spread)
-    written["comparison"] = write_parquet(table, out / "comparison.parquet")
-    md = comparison_markdown(
-        table,
-        command=_command_line(out, user, sweeps, sensitivity),
-        run=run,
-        sweep_runs=sweep_runs,
-        section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
-    )
     spot = [r["hours_per_100um"] for r in run.tables["wear"].to_pylist() if r["hours_per_100um"] is not None]
-    md += wear_map_markdown(wear_map, min(spot) if spot else None)
-    written["comparison_md"] = write_text(md + fatigue_markdown(fatigue), out / "comparison.md")
-    return written
+    return wear_map_markdown(wear_map, min(spot) if spot else None) + fatigue_markdown(fatigue)
 
 
 def _run_section4(
@@ -181,7 +200,9 @@ def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
     return scene
 
 
-def _command_line(out: Path, overrides: Sequence[str], sweeps: bool, sensitivity: str | os.PathLike[str] | None) -> str:
+def _command_line(
+    out: Path, overrides: Sequence[str], sweeps: bool, sensitivity: str | os.PathLike[str] | None, verify: bool
+) -> str:
     args = ["ballcage", "paper", "--out", str(out)]
     for o in overrides:
         args += ["--set", o]
@@ -189,4 +210,6 @@ def _command_line(out: Path, overrides: Sequence[str], sweeps: bool, sensitivity
         args.append("--sweeps")
     if sensitivity is not None:
         args += ["--sensitivity", os.fspath(sensitivity)]
+    if not verify:
+        args.append("--no-verify")
     return shlex.join(args)

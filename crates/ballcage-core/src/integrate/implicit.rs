@@ -959,7 +959,12 @@ impl Implicit {
                 if let Some(blk) = blk {
                     let bi = self.dofs[i].expect("integrated").1;
                     let bj = self.dofs[j].expect("integrated").1;
-                    linear.add(*blk, &project(bi, bj, m), -hh);
+                    if (bi, bj) == (Basis::Full, Basis::Full) {
+                        // Most blocks: no projection, and no copy of the block.
+                        linear.add(*blk, m, -hh);
+                    } else {
+                        linear.add(*blk, &project(bi, bj, m), -hh);
+                    }
                 }
             }
         }
