@@ -190,7 +190,7 @@ def test_ctrl_c_writes_what_was_computed_marked_incomplete(tmp_path, monkeypatch
     import ballcage.run
 
     calls = {"n": 0}
-    real_update = ballcage.run._ProgressBar.update
+    real_update = ballcage.run.ProgressBar.update
 
     def interrupt_on_the_tenth(self, t):
         calls["n"] += 1
@@ -198,7 +198,7 @@ def test_ctrl_c_writes_what_was_computed_marked_incomplete(tmp_path, monkeypatch
             raise KeyboardInterrupt
         real_update(self, t)
 
-    monkeypatch.setattr(ballcage.run._ProgressBar, "update", interrupt_on_the_tenth)
+    monkeypatch.setattr(ballcage.run.ProgressBar, "update", interrupt_on_the_tenth)
     out = tmp_path / "out"
     code = ballcage.cli.main(["run", str(BALL_DROP), "--out", str(out), "--quiet"])
     assert code == 130

@@ -9,7 +9,7 @@ import pyarrow as pa
 import pytest
 
 import ballcage
-from ballcage.run import _ProgressBar
+from ballcage.run import ProgressBar
 
 G = 9.81
 Z0 = 10.0
@@ -136,7 +136,7 @@ def test_forced_progress_on_a_pipe_prints_a_line_every_ten_percent(free_fall, ca
 def test_progress_bar_appears_only_after_the_delay():
     now = [0.0]
     out = io.StringIO()
-    bar = _ProgressBar(None, duration=2.0, stream=out, clock=lambda: now[0])
+    bar = ProgressBar(None, duration=2.0, stream=out, clock=lambda: now[0])
     bar.update(0.5)
     assert out.getvalue() == ""
     now[0] = 1.6
@@ -146,7 +146,7 @@ def test_progress_bar_appears_only_after_the_delay():
     assert out.getvalue().splitlines()[0].startswith("ballcage:  40%")
     assert out.getvalue().splitlines()[-1].startswith("ballcage: 100%")
     silent = io.StringIO()
-    never = _ProgressBar(False, duration=2.0, stream=silent, clock=lambda: 99.0)
+    never = ProgressBar(False, duration=2.0, stream=silent, clock=lambda: 99.0)
     never.update(1.0)
     assert silent.getvalue() == ""
 
@@ -157,7 +157,7 @@ def test_progress_bar_on_a_terminal_redraws_one_line():
             return True
 
     out = Terminal()
-    bar = _ProgressBar(True, duration=0.2, stream=out, clock=lambda: 0.0)
+    bar = ProgressBar(True, duration=0.2, stream=out, clock=lambda: 0.0)
     for t in (0.139, 0.14, 0.2):
         bar.update(t)
     bar.close()

@@ -203,13 +203,67 @@ def test_an_interrupt_during_the_verification_keeps_the_runs_tables(tmp_path, ca
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(ballcage.verify, "simulate", interrupted)
+    monkeypatch.setattr(ballcage.verify, "check_run", interrupted)  # in the verification run's thread
     out = tmp_path / "out"
     code = cli.main(["run", str(TWO_BALLS), "--verify", "--quiet", "--out", str(out), "--set", SDIRK2])
     err = capsys.readouterr().err
     assert code == 130
     assert "interrupted during the verification run; the run's own tables" in err
     assert pq.read_table(out / "bodies.parquet").schema.metadata[b"ballcage.complete"] == b"true"
+
+
+def test_the_verification_run_goes_on_beside_the_run_and_gives_what_it_gives_after_it(monkeypatch):
+    import ballcage.run
+    import ballcage.verify
+
+    events = []
+    real_check, real_run = ballcage.verify.check_run, ballcage.run._run
+
+    def check(*args, **kwargs):
+        events.append("check starts")
+        return real_check(*args, **kwargs)
+
+    def main(*args, **kwargs):
+        out = real_run(*args, **kwargs)
+        events.append("run ends")
+        return out
+
+    monkeypatch.setattr(ballcage.verify, "check_run", check)
+    monkeypatch.setattr(ballcage.run, "_run", main)
+    beside = _verified(COARSE)
+    assert events.index("check starts") < events.index("run ends")  # started before the run ended
+    monkeypatch.undo()
+    # The same table as a verification run after the run (ballcage.verify.verify on the finished run).
+    after = ballcage.verify.verify(beside, progress=False)
+    assert beside.verification is not None
+    assert beside.verification.table.select(["quantity", "run_value", "verify_value"]).equals(
+        after.table.select(["quantity", "run_value", "verify_value"])
+    )
+
+
+def test_a_run_that_fails_stops_its_verification_run(monkeypatch):
+    import threading
+
+    import ballcage.run
+    import ballcage.verify
+
+    outcomes = []
+    real_check = ballcage.verify.check_run
+
+    def check(*args, **kwargs):
+        try:
+            return real_check(*args, **kwargs)
+        except BaseException as e:
+            outcomes.append(type(e).__name__)
+            raise
+
+    monkeypatch.setattr(ballcage.verify, "check_run", check)
+    # dt/4 makes the verification run four times longer than the run, which stops at its first piece.
+    with pytest.raises(ballcage.run.TimeLimitError):
+        ballcage.simulate(TWO_BALLS, overrides=[SDIRK2, "simulation.dt=1e-5"], progress=False, verify=True,
+                          time_limit=1e-9)  # fmt: skip
+    assert outcomes == ["Cancelled"]  # stopped at its next piece, not run to its end
+    assert not [t for t in threading.enumerate() if t.name == "ballcage-verify"]
 
 
 def test_a_scene_without_contact_pairs_has_no_error_to_measure(tmp_path, capsys):

@@ -56,9 +56,9 @@ from ballcage.run import Run, simulate
 from ballcage.scene import DrillPipeBuilder, SceneBuilder, load_scene, proposals
 from ballcage.sizing import largest_link_diameter, longest_link, tightest_radius_for_link
 
-# `simulate(..., verify=True)` measures the run's error with `ballcage.verify.verify`, which lies above
+# `simulate(..., verify=True)` measures the run's error with `ballcage.verify`, which lies above
 # `ballcage.run` (it takes a drill pipe's quantities from `ballcage.measures`): wired here, on top.
-_run.VERIFIER = lambda run, progress: _verify.verify(run, progress=progress)
+_run.VERIFIER = _verify.VERIFIER
 
 __version__: str = _native.__version__
 

@@ -11,10 +11,12 @@ frames recorded so far (the sweeps' ``--case-timeout``).
 
 ``simulate(..., verify=True)`` repeats the run ten times tighter and keeps the
 difference of each headline quantity as the run's measured error
-(`Verification`, ``verify.parquet``). That work is `ballcage.verify.verify`,
-above this module (it takes a drill pipe's quantities from
-`ballcage.measures`); this module calls it through `VERIFIER`, which the
-package's facade (``ballcage/__init__.py``) sets, so it never imports it.
+(`Verification`, ``verify.parquet``). The tighter run goes on in a thread of
+its own beside the run (the engine releases the GIL: on two cores the pair
+takes about the time of the tighter run alone). That work is
+`ballcage.verify`, above this module (it takes a drill pipe's quantities
+from `ballcage.measures`); this module calls it through `VERIFIER`, which
+the package's facade (``ballcage/__init__.py``) sets, so it never imports it.
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, Any, Protocol, TextIO
 
 from ballcage import _native
 from ballcage._files import parquet_writer, write_all_atomically
@@ -81,6 +83,10 @@ class VerificationError(_native.SimulationError):
     check: Run | None
 
 
+class Cancelled(Exception):
+    """A run stopped by its `watch` (`_run`): the verification run of a run that failed or was interrupted."""
+
+
 class TimeLimitError(_native.Error, TimeoutError):
     """A run stopped because its wall time passed ``simulate(..., time_limit=)``.
 
@@ -104,9 +110,21 @@ class TimeLimitError(_native.Error, TimeoutError):
         self.run, self.limit_s, self.elapsed_s, self.t_s = run, limit_s, elapsed_s, t_s
 
 
-#: ``VERIFIER(run, progress)`` measures a complete run's error for ``simulate(..., verify=True)``:
-#: `ballcage.verify.verify`, set by the package's facade.
-VERIFIER: Callable[[Run, bool | None], Verification] | None = None
+class Verifier(Protocol):
+    """What ``simulate(..., verify=True)`` needs of `ballcage.verify` (`VERIFIER`)."""
+
+    def start(self, scene: _native.Scene, progress: bool | None) -> Any:
+        """Starts the verification run of `scene` beside its run; returns a handle for `finish`."""
+
+    def finish(self, run: Run, progress: bool | None, started: Any) -> Verification:
+        """The `Verification` of the complete `run` from the verification run `started`."""
+
+    def cancel(self, started: Any) -> None:
+        """Stops the verification run `started` (its run failed or was interrupted)."""
+
+
+#: Measures a run's error for ``simulate(..., verify=True)``: `ballcage.verify`, set by the package's facade.
+VERIFIER: Verifier | None = None
 
 
 class Run:
@@ -299,24 +317,41 @@ def simulate(
     resolved = load_scene(scene, overrides)
     if verify and "summary" not in resolved.table_names:
         resolved = load_scene(resolved, ["record.tables=" + json.dumps([*resolved.table_names, "summary"])])
-    run = _run(resolved, progress, time_limit)
-    if verify:
-        if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
-            raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
-        run.verification = VERIFIER(run, progress)
+    if not verify:
+        return _run(resolved, progress, time_limit)
+    if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
+        raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
+    started = VERIFIER.start(resolved, progress)
+    try:
+        run = _run(resolved, progress, time_limit)
+    except BaseException:
+        VERIFIER.cancel(started)
+        raise
+    run.verification = VERIFIER.finish(run, progress, started)
     return run
 
 
-def _run(resolved: _native.Scene, progress: bool | None, time_limit: float | None = None) -> Run:
-    """`simulate` of a validated scene, without verification; stopped past `time_limit` [s] of wall time."""
+def _run(
+    resolved: _native.Scene,
+    progress: bool | None,
+    time_limit: float | None = None,
+    watch: Callable[[float], bool] | None = None,
+) -> Run:
+    """`simulate` of a validated scene, without verification; stopped past `time_limit` [s] of wall time.
+
+    `watch`, if given, is called with the simulated time after each piece; when it returns true the run stops
+    with `Cancelled` (the verification run of a run that failed).
+    """
     start = time.monotonic()
     sim = _native.Simulation(resolved)
     duration = sim.duration
-    bar = _ProgressBar(progress, duration)
+    bar = ProgressBar(progress, duration)
     try:
         for i in range(1, CHUNKS + 1):
             sim.advance(duration if i == CHUNKS else duration * i / CHUNKS)
             bar.update(sim.time)
+            if watch is not None and watch(sim.time) and i < CHUNKS:
+                raise Cancelled(f"cancelled at t = {sim.time:.6g} s of {duration:.6g} s")
             elapsed = time.monotonic() - start
             if time_limit is not None and elapsed > time_limit and i < CHUNKS:
                 raise _past_limit(sim, resolved, time_limit, elapsed)
@@ -334,6 +369,12 @@ def _run(resolved: _native.Scene, progress: bool | None, time_limit: float | Non
     return Run(sim.finish(), resolved.to_toml(), scene=resolved)
 
 
+def run_watched(scene: SceneSource, overrides: Iterable[str], watch: Callable[[float], bool]) -> Run:
+    """`simulate` of `scene` with `overrides`, without a progress bar, `watch` called with the simulated time after
+    each of its pieces: when it returns true the run stops with `Cancelled` (the verification run, `ballcage.verify`)."""
+    return _run(load_scene(scene, overrides), False, None, watch)
+
+
 def _past_limit(sim: _native.Simulation, resolved: _native.Scene, limit: float, elapsed: float) -> TimeLimitError:
     """The `TimeLimitError` of a run stopped at `elapsed` s past its `limit`, with the frames recorded so far."""
     t, duration = sim.time, sim.duration
@@ -345,7 +386,7 @@ def _past_limit(sim: _native.Simulation, resolved: _native.Scene, limit: float, 
     return TimeLimitError(message, run=run, limit_s=limit, elapsed_s=elapsed, t_s=t)
 
 
-class _ProgressBar:
+class ProgressBar:
     """A dependency-free progress bar on stderr.
 
     On a terminal it redraws one line with ``\\r``; otherwise (a log file, CI)

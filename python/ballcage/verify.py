@@ -1,7 +1,10 @@
 """A run's measured error: the same scene ten times tighter, and the difference of each headline quantity.
 
-``ballcage run --verify`` and ``simulate(..., verify=True)`` call `verify` on
-the finished run (`ballcage.run.VERIFIER`). It reruns the scene at the
+``ballcage run --verify`` and ``simulate(..., verify=True)`` start the
+verification run beside the run (`Started`, in a thread of its own: the
+engine releases the GIL, so on two cores both take about the time of the
+longer) and finish it with `verify` (`VERIFIER`, the hook
+`ballcage.run.VERIFIER`); `verify` alone checks a finished run after it. It runs the scene at the
 setting `tighter` gives (``dt/4`` for SDIRK2, ``rtol/10`` for adaptive steps;
 the rule lives in `ballcage.studies.refinement`, which ``ballcage sensitivity`` shares),
 takes the headline quantities of both runs (`headline`: the drill pipe's
@@ -26,11 +29,12 @@ import inspect
 import json
 import math
 import sys
+import threading
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
-from ballcage.run import Run, Verification, VerificationError, simulate
+from ballcage.run import ProgressBar, Run, Verification, VerificationError, run_watched, simulate
 from ballcage.studies.refinement import TIGHTER, Tighter, tighter
 
 if TYPE_CHECKING:
@@ -71,28 +75,110 @@ COLUMNS: dict[str, tuple[str, str, str]] = {
 }  # fmt: skip
 
 
-def verify(run: Run, *, progress: bool | None = None) -> Verification:
-    """Runs `run`'s scene at the `tighter` setting and compares their `headline` quantities.
+class Started:
+    """The verification run of `scene` going on in a thread of its own beside the run it checks (`verify`).
 
-    `run` must be complete. `progress` is as for `simulate`; unless it is
-    ``False``, a line on stderr announces the verification run. Raises
-    `VerificationError` when the verification run diverges or its scene is
-    refused; an interrupt (`KeyboardInterrupt`) during it is re-raised
-    carrying `run`, complete, as ``e.run``.
+    The thread runs `scene` at the `tighter` setting without a bar; what it
+    returns or raises is handed over by `result`. `cancel` stops it at its
+    next piece (`ballcage.run.run_watched`): the run it checks failed. A
+    daemon thread, so that it never holds up the interpreter's exit.
+    """
+
+    def __init__(self, scene: _native.Scene, progress: bool | None) -> None:
+        self.setting = tighter(scene)
+        if progress is not False:
+            print(f"ballcage: verifying: the run again at {self.setting.label} ({', '.join(self.setting.overrides)})",
+                  file=sys.stderr)  # fmt: skip
+        self._stop = threading.Event()
+        self._t = 0.0
+        self._duration = scene.duration
+        self._outcome: Run | BaseException | None = None
+        self._thread = threading.Thread(target=self._work, args=(scene,), name="ballcage-verify", daemon=True)
+        self._thread.start()
+
+    def _work(self, scene: _native.Scene) -> None:
+        try:
+            self._outcome = check_run(scene, self.setting.overrides, self._watch)
+        except BaseException as e:  # noqa: BLE001 - raised again in the caller's thread by `result`
+            self._outcome = e
+
+    def _watch(self, t: float) -> bool:
+        self._t = t
+        return self._stop.is_set()
+
+    def cancel(self) -> None:
+        """Stops the verification run at its next piece, and waits for it."""
+        self._stop.set()
+        self._thread.join()
+
+    def result(self, progress: bool | None) -> Run:
+        """The verification run, complete, or what it raised; waits for it with a bar of its own (`progress`)."""
+        if self._thread.is_alive():
+            bar = ProgressBar(progress, self._duration)
+            try:
+                while self._thread.is_alive():
+                    self._thread.join(0.1)
+                    bar.update(self._t)
+            finally:
+                bar.close()
+        if isinstance(self._outcome, BaseException):
+            raise self._outcome
+        assert self._outcome is not None  # the thread has ended
+        return self._outcome
+
+
+def check_run(scene: _native.Scene, overrides: tuple[str, ...], watch: Any) -> Run:
+    """The verification run: `scene` with the tighter `overrides`, `watch` called after each piece (`Started`)."""
+    return run_watched(scene, overrides, watch)
+
+
+class _Verifier:
+    """`ballcage.run.VERIFIER`: the verification run started beside the run (`Started`) and finished by `verify`."""
+
+    def start(self, scene: _native.Scene, progress: bool | None) -> Started:
+        return Started(scene, progress)
+
+    def finish(self, run: Run, progress: bool | None, started: Started) -> Verification:
+        return verify(run, progress=progress, started=started)
+
+    def cancel(self, started: Started) -> None:
+        started.cancel()
+
+
+#: The hook the package's facade sets as `ballcage.run.VERIFIER`.
+VERIFIER = _Verifier()
+
+
+def verify(run: Run, *, progress: bool | None = None, started: Started | None = None) -> Verification:
+    """Compares `run`'s `headline` quantities with those of its scene at the `tighter` setting.
+
+    `run` must be complete. The verification run is `started` (begun beside
+    `run` by ``simulate(..., verify=True)``), or else run now. `progress` is
+    as for `simulate`; unless it is ``False``, a line on stderr announces the
+    verification run. Raises `VerificationError` when the verification run
+    diverges or its scene is refused; an interrupt (`KeyboardInterrupt`)
+    during it is re-raised carrying `run`, complete, as ``e.run``.
     """
     if not run.complete:
+        if started is not None:
+            started.cancel()
         raise _native.InputError(f"cannot verify an incomplete run ({run.error or 'ballcage.complete = false'})")
-    setting = tighter(run.scene)
-    if progress is not False:  # the verification run's bar starts again from 0 %
+    setting = tighter(run.scene) if started is None else started.setting
+    if progress is not False and started is None:  # the verification run's bar starts again from 0 %
         print(f"ballcage: verifying: the run again at {setting.label} ({', '.join(setting.overrides)})", file=sys.stderr)
     try:
-        check = simulate(run.scene, overrides=setting.overrides, progress=progress)
+        if started is None:
+            check = simulate(run.scene, overrides=setting.overrides, progress=progress)
+        else:
+            check = started.result(progress)
         table = compare(headline(run), headline(check))
     except (_native.SimulationError, _native.SceneError) as e:
         error = VerificationError(f"the verification run at {setting.label} failed: {e}")
         error.run, error.check = run, getattr(e, "run", None)
         raise error from e
     except KeyboardInterrupt as e:
+        if started is not None:
+            started.cancel()
         e.run = run  # type: ignore[attr-defined]  # the complete run, not the verification's part
         raise
     rel = [(r, q) for r, q in zip(table["rel_difference"].to_pylist(), table["quantity"].to_pylist()) if r is not None]
