@@ -145,7 +145,7 @@ def test_cli_simulation_error_exits_1_with_its_message(tmp_path, ball_drop_path,
     def diverge(*args, **kwargs):
         raise ballcage.SimulationError("simulation diverged at t = 1.0e-01 s (step 2000): ball left the world")
 
-    monkeypatch.setattr(cli.run, "simulate", diverge)
+    monkeypatch.setattr(cli.run, "simulate_then", diverge)
     assert cli.main(["run", str(ball_drop_path), "--out", str(tmp_path / "out")]) == 1
     err = capsys.readouterr().err
     assert err == "ballcage: error: simulation diverged at t = 1.0e-01 s (step 2000): ball left the world\n"

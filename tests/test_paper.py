@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import subprocess
 import sys
+import time
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -250,6 +251,25 @@ def test_a_failed_verification_leaves_a_complete_report_without_the_column_and_e
     table = pq.read_table(out / "comparison.parquet")
     assert table.column("numerical_error").null_count == table.num_rows
     assert "**Numerical error: the verification run at dt/4 failed: " in (out / "comparison.md").read_text()
+
+
+def test_a_paper_run_that_fails_stops_its_verification_run(tmp_path, monkeypatch):
+    import threading
+
+    import ballcage.run
+
+    real_run = ballcage.run._run
+
+    def diverging(resolved, progress, time_limit=None, watch=None):
+        if watch is not None:  # the verification run (ballcage.run.run_watched) goes on
+            return real_run(resolved, progress, time_limit, watch)
+        time.sleep(0.2)  # the verification run has started beside it
+        raise ballcage.SimulationError("diverged (made up by the test)")
+
+    monkeypatch.setattr(ballcage.run, "_run", diverging)
+    with pytest.raises(ballcage.SimulationError, match="made up by the test"):
+        paper.run_paper(tmp_path / "p", ["simulation.duration=0.5"], progress=False)
+    assert not [t for t in threading.enumerate() if t.name == "ballcage-verify" and t.is_alive()]
 
 
 def test_comparison_fills_sweep_rows_from_given_runs(short_run):

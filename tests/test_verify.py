@@ -241,6 +241,26 @@ def test_the_verification_run_goes_on_beside_the_run_and_gives_what_it_gives_aft
     )
 
 
+def test_simulate_then_works_on_the_run_before_its_verification_ends_and_hands_over_both():
+    from ballcage.run import simulate_then
+
+    seen = []
+
+    def work(run: ballcage.Run) -> str:
+        seen.append(run.verification)  # not yet: the verification run goes on beside this work
+        return "done"
+
+    run, done = simulate_then(TWO_BALLS, work, overrides=[SDIRK2, f"simulation.dt={COARSE!r}"], progress=False,
+                              verify=True)  # fmt: skip
+    assert seen == [None] and done == "done"
+    assert run.verification is not None and run.verification.setting == "dt/4"
+    # A verification run refused (simulation.max_steps, as above) is raised after the work, which it carries.
+    with pytest.raises(VerificationError) as info:
+        simulate_then(TWO_BALLS, work, overrides=[SDIRK2, f"simulation.dt={COARSE!r}", "simulation.max_steps=1500"],
+                      progress=False, verify=True)  # fmt: skip
+    assert info.value.done == "done" and info.value.run.complete and len(seen) == 2
+
+
 def test_a_run_that_fails_stops_its_verification_run(monkeypatch):
     import threading
 

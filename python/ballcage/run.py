@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol, TextIO
+from typing import TYPE_CHECKING, Any, Protocol, TextIO, TypeVar
 
 from ballcage import _native
 from ballcage._files import parquet_writer, write_all_atomically
@@ -38,7 +38,10 @@ from ballcage.scene import SceneSource, load_scene
 if TYPE_CHECKING:
     import pyarrow as pa
 
-__all__ = ["VERIFY_FILE", "Run", "TimeLimitError", "Verification", "VerificationError", "simulate"]
+__all__ = ["VERIFY_FILE", "Run", "TimeLimitError", "Verification", "VerificationError", "simulate", "simulate_then"]
+
+#: What the work `simulate_then` does beside a verification run returns.
+T = TypeVar("T")
 
 #: Number of `advance` calls a run is split into.
 CHUNKS = 200
@@ -314,21 +317,68 @@ def simulate(
     """
     if time_limit is not None and not (math.isfinite(time_limit) and time_limit > 0):
         raise _native.InputError(f"time_limit = {time_limit!r}: must be a positive number of seconds (None: no limit)")
+    resolved = _resolved(scene, overrides, verify)
+    if not verify:
+        return _run(resolved, progress, time_limit)
+    return _verified(resolved, progress, time_limit, _nothing)[0]
+
+
+def simulate_then(
+    scene: SceneSource,
+    work: Callable[[Run], T],
+    *,
+    overrides: Iterable[str] = (),
+    progress: bool | None = None,
+    verify: bool = False,
+) -> tuple[Run, T]:
+    """`simulate`, with `work(run)` done on the complete run while its verification run goes on beside it.
+
+    Returns the run (with `verify`, its ``verification`` set once `work` is
+    done and the verification run has ended) and what `work` returned: the
+    paper report and ``ballcage run`` write their tables and figures while
+    the tighter run goes on. Raises as `simulate`; a run that fails, or
+    `work` that raises, stops the verification run. A verification run that
+    fails raises its `VerificationError` after `work`, carrying the run as
+    ``e.run`` and what `work` returned as ``e.done``.
+    """
+    resolved = _resolved(scene, overrides, verify)
+    if not verify:
+        run = _run(resolved, progress)
+        return run, work(run)
+    return _verified(resolved, progress, None, work)
+
+
+def _resolved(scene: SceneSource, overrides: Iterable[str], verify: bool) -> _native.Scene:
+    """The validated scene of `simulate`: with `verify`, recording ``summary`` (the headline quantities need it)."""
     resolved = load_scene(scene, overrides)
     if verify and "summary" not in resolved.table_names:
         resolved = load_scene(resolved, ["record.tables=" + json.dumps([*resolved.table_names, "summary"])])
-    if not verify:
-        return _run(resolved, progress, time_limit)
+    return resolved
+
+
+def _nothing(run: Run) -> None:
+    """The work `simulate` does beside its verification run: none."""
+
+
+def _verified(
+    resolved: _native.Scene, progress: bool | None, time_limit: float | None, work: Callable[[Run], T]
+) -> tuple[Run, T]:
+    """The run of `resolved` and `work` on it, its verification run going on beside both (`VERIFIER`)."""
     if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
         raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
     started = VERIFIER.start(resolved, progress)
     try:
         run = _run(resolved, progress, time_limit)
+        done = work(run)
     except BaseException:
         VERIFIER.cancel(started)
         raise
-    run.verification = VERIFIER.finish(run, progress, started)
-    return run
+    try:
+        run.verification = VERIFIER.finish(run, progress, started)
+    except VerificationError as e:
+        e.done = done  # type: ignore[attr-defined]
+        raise
+    return run, done
 
 
 def _run(

@@ -9,6 +9,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ballcage import _native
+from ballcage._files import write_parquet
 from ballcage.cli._common import (
     TABLE_NAMES,
     Commands,
@@ -23,7 +24,7 @@ from ballcage.cli._common import (
     load_cli_scene,
     names,
 )
-from ballcage.run import VERIFY_FILE, Run, simulate
+from ballcage.run import VERIFY_FILE, Run, simulate_then
 from ballcage.studies.common import implicit_steps, newton_per_stage
 from ballcage.verify import VerificationError, disagreements, verdict
 
@@ -95,17 +96,29 @@ def command(args: argparse.Namespace) -> int:
             scene = load_cli_scene(args.scene, [*overrides, "record.tables=" + json.dumps(tables)])
         except UsageError as e:  # the scene loaded without the tables: they are what it refuses
             raise UsageError(f"--tables {','.join(tables)}: {e}") from e
+
+    def write(run: Run) -> tuple[pa.Table | None, pa.Table | None]:
+        # The tables and what is derived from them, while the verification run goes on beside.
+        _write(run, out, args.quiet)
+        return _fatigue(run, out, args.quiet), _wear_map(run, out, args.quiet)
+
     try:
-        result = simulate(scene, progress=False if args.quiet else None, verify=args.verify)
+        result, (fatigue, wear_map) = simulate_then(
+            scene, write, progress=False if args.quiet else None, verify=args.verify
+        )
+    except VerificationError as e:  # the run's files are written; verify.parquet is not
+        return _failed(e, e.run, out)
     except (_native.SimulationError, KeyboardInterrupt) as e:
         partial = getattr(e, "run", None)
         if partial is None:
             raise
-        _write(partial, out, args.quiet)
+        if not partial.complete:  # the run stopped: what it recorded (a complete run's files are written)
+            _write(partial, out, args.quiet)
         return _failed(e, partial, out)
-    _write(result, out, args.quiet)
-    fatigue = _fatigue(result, out, args.quiet)
-    wear_map = _wear_map(result, out, args.quiet)
+    if result.verification is not None:
+        path = write_parquet(result.verification.table, out / VERIFY_FILE)
+        if not args.quiet:
+            print(_summary("verify", path, result.verification.table))
     if not args.quiet:
         _report(result, fatigue, wear_map)
     return 0
@@ -118,8 +131,7 @@ def _write(result: Run, out: Path, quiet: bool) -> None:
     paths = result.write(out)
     if not quiet:
         for name, path in paths.items():
-            table = result.verification.table if name == "verify" and result.verification else result.tables.get(name)
-            print(_summary(name, path, table))
+            print(_summary(name, path, result.tables.get(name)))
 
 
 def _fatigue(result: Run, out: Path, quiet: bool) -> pa.Table | None:

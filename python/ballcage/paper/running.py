@@ -17,8 +17,7 @@ from ballcage.paper.fatigue import fatigue_markdown, write_fatigue_or_why
 from ballcage.paper.figures import write_figures
 from ballcage.paper.markdown import comparison_markdown
 from ballcage.paper.wear_map import wear_map_markdown, write_wear_map
-from ballcage import run as run_module
-from ballcage.run import VERIFY_FILE, Run, VerificationError, simulate
+from ballcage.run import VERIFY_FILE, Run, VerificationError, simulate_then
 from ballcage.scene import default_scene, override_list
 from ballcage.view import write_view
 
@@ -97,11 +96,7 @@ def run_paper(
     spec = section4_spec(user) if sweeps else None
     if spec is not None:
         spec.check()
-    started = _start_verification(main_scene, progress) if verify else None
-    run = _main_run(main_scene, progress, started)
-    written = run.write(out)
-    derived = _write_derived(run, out, written)  # while the verification run goes on
-    failure = _finish_verification(run, progress, started, out, written) if started is not None else None
+    run, written, derived, failure = _run_and_write(main_scene, out, progress, verify)
     section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
     sweep_runs = section4[0].variant_runs() if section4 is not None else None
     table = with_numerical_error(comparison(run, sweep_runs), run.verification)
@@ -123,36 +118,24 @@ def run_paper(
     return written
 
 
-def _start_verification(scene: _native.Scene, progress: bool | None) -> Any:
-    """The verification run of `scene`, begun beside the paper run as ``simulate(..., verify=True)`` begins it
-    (`ballcage.run.VERIFIER`), so that the figures, wear map and fatigue table are written while it goes on."""
-    if run_module.VERIFIER is None:  # the facade sets it on `import ballcage`
-        raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
-    return run_module.VERIFIER.start(scene, progress)
+def _run_and_write(
+    scene: _native.Scene, out: Path, progress: bool | None, verify: bool
+) -> tuple[Run, dict[str, Path], str, VerificationError | None]:
+    """The paper run, its tables and `_write_derived`'s files, written while its verification run goes on
+    (`simulate_then`), and ``verify.parquet``; returns the run, the written paths, the derived Markdown and a
+    failed verification (not raised)."""
 
+    def write(run: Run) -> tuple[dict[str, Path], str]:
+        written = run.write(out)  # without verify.parquet: the verification is not done yet
+        return written, _write_derived(run, out, written)
 
-def _main_run(scene: _native.Scene, progress: bool | None, started: Any) -> Run:
-    """The paper run; the verification run `started` beside it is stopped when it fails."""
     try:
-        return simulate(scene, progress=progress)
-    except BaseException:
-        if started is not None and run_module.VERIFIER is not None:
-            run_module.VERIFIER.cancel(started)
-        raise
-
-
-def _finish_verification(
-    run: Run, progress: bool | None, started: Any, out: Path, written: dict[str, Path]
-) -> VerificationError | None:
-    """Waits for the verification run `started`, sets ``run.verification`` and writes ``verify.parquet``; a
-    failed verification run is returned, not raised."""
-    assert run_module.VERIFIER is not None  # checked by _start_verification
-    try:
-        run.verification = run_module.VERIFIER.finish(run, progress, started)
+        run, (written, derived) = simulate_then(scene, write, progress=progress, verify=verify)
     except VerificationError as e:
-        return e
-    written["verify"] = write_parquet(run.verification.table, out / VERIFY_FILE)
-    return None
+        return e.run, *e.done, e  # type: ignore[attr-defined]
+    if run.verification is not None:
+        written["verify"] = write_parquet(run.verification.table, out / VERIFY_FILE)
+    return run, written, derived, None
 
 
 def _write_derived(run: Run, out: Path, written: dict[str, Path]) -> str:
