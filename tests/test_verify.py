@@ -203,7 +203,7 @@ def test_an_interrupt_during_the_verification_keeps_the_runs_tables(tmp_path, ca
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(ballcage.verify, "check_run", interrupted)  # in the verification run's thread
+    monkeypatch.setattr(ballcage.verify, "run_watched", interrupted)  # in the verification run's thread
     out = tmp_path / "out"
     code = cli.main(["run", str(TWO_BALLS), "--verify", "--quiet", "--out", str(out), "--set", SDIRK2])
     err = capsys.readouterr().err
@@ -217,7 +217,7 @@ def test_the_verification_run_goes_on_beside_the_run_and_gives_what_it_gives_aft
     import ballcage.verify
 
     events = []
-    real_check, real_run = ballcage.verify.check_run, ballcage.run._run
+    real_check, real_run = ballcage.verify.run_watched, ballcage.run._run
 
     def check(*args, **kwargs):
         events.append("check starts")
@@ -228,7 +228,7 @@ def test_the_verification_run_goes_on_beside_the_run_and_gives_what_it_gives_aft
         events.append("run ends")
         return out
 
-    monkeypatch.setattr(ballcage.verify, "check_run", check)
+    monkeypatch.setattr(ballcage.verify, "run_watched", check)
     monkeypatch.setattr(ballcage.run, "_run", main)
     beside = _verified(COARSE)
     assert events.index("check starts") < events.index("run ends")  # started before the run ended
@@ -268,7 +268,7 @@ def test_a_run_that_fails_stops_its_verification_run(monkeypatch):
     import ballcage.verify
 
     outcomes = []
-    real_check = ballcage.verify.check_run
+    real_check = ballcage.verify.run_watched
 
     def check(*args, **kwargs):
         try:
@@ -277,7 +277,7 @@ def test_a_run_that_fails_stops_its_verification_run(monkeypatch):
             outcomes.append(type(e).__name__)
             raise
 
-    monkeypatch.setattr(ballcage.verify, "check_run", check)
+    monkeypatch.setattr(ballcage.verify, "run_watched", check)
     # dt/4 makes the verification run four times longer than the run, which stops at its first piece.
     with pytest.raises(ballcage.run.TimeLimitError):
         ballcage.simulate(TWO_BALLS, overrides=[SDIRK2, "simulation.dt=1e-5"], progress=False, verify=True,

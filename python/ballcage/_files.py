@@ -123,6 +123,16 @@ def png_writer(figure: Figure, dpi: int = 120) -> Callable[[Path], None]:
     return write
 
 
+def write_with_figure(
+    key: str, table: pa.Table, figure: Figure, out: Path, files: tuple[str, str]
+) -> dict[str, Path]:
+    """Writes `table` (Parquet) and `figure` (PNG) into `out` as `files`, both or neither (a run killed while writing
+    them leaves no table without its figure); returns their paths as ``key`` and ``<key>_figure``."""
+    paths = {key: out / files[0], f"{key}_figure": out / files[1]}
+    write_all_atomically({paths[key]: parquet_writer(table), paths[f"{key}_figure"]: png_writer(figure)})
+    return paths
+
+
 def write_png(figure: Figure, path: Path, dpi: int = 120) -> Path:
     """Renders `figure` to `path` as PNG at `dpi` dots per inch (`png_writer`), atomically; returns `path`."""
     write_atomically(path, png_writer(figure, dpi))

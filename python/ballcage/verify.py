@@ -98,7 +98,7 @@ class Started:
 
     def _work(self, scene: _native.Scene) -> None:
         try:
-            self._outcome = check_run(scene, self.setting.overrides, self._watch)
+            self._outcome = run_watched(scene, self.setting.overrides, self._watch)
         except BaseException as e:  # noqa: BLE001 - raised again in the caller's thread by `result`
             self._outcome = e
 
@@ -125,11 +125,6 @@ class Started:
             raise self._outcome
         assert self._outcome is not None  # the thread has ended
         return self._outcome
-
-
-def check_run(scene: _native.Scene, overrides: tuple[str, ...], watch: Any) -> Run:
-    """The verification run: `scene` with the tighter `overrides`, `watch` called after each piece (`Started`)."""
-    return run_watched(scene, overrides, watch)
 
 
 class _Verifier:

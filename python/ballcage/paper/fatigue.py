@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pyarrow as pa
 
-from ballcage._files import parquet_writer, png_writer, write_all_atomically
+from ballcage._files import write_with_figure
 from ballcage._native import InputError
 from ballcage._plot import figure, series_styles
 from ballcage.measures.fatigue import fatigue_table, section_stresses
@@ -32,13 +32,7 @@ def write_fatigue(run: Run, out: Path) -> tuple[pa.Table, dict[str, Path]]:
     loads = section_loads(run, sections)
     table = fatigue_table(run, sections, loads)
     fig = _figure(table, sections, loads)
-    written = {"fatigue": out / FATIGUE_FILE, "fatigue_figure": out / FATIGUE_FIGURE}
-    # both or neither, as the wear map: a run killed while writing them leaves no table without its figure
-    write_all_atomically({
-        written["fatigue"]: parquet_writer(table),
-        written["fatigue_figure"]: png_writer(fig),
-    })  # fmt: skip
-    return table, written
+    return table, write_with_figure("fatigue", table, fig, out, (FATIGUE_FILE, FATIGUE_FIGURE))
 
 
 def write_fatigue_or_why(run: Run, out: Path, written: dict[str, Path]) -> pa.Table | str:

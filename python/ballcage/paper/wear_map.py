@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pyarrow as pa
 
-from ballcage._files import parquet_writer, png_writer, write_all_atomically
+from ballcage._files import write_with_figure
 from ballcage.measures.wear_map import deepest, hours_line, wear_map
 from ballcage.run import Run
 from ballcage.view.wear import WEAR_FIGURE_FILE, WEAR_MAP_FILE, wear_figure
@@ -20,13 +20,7 @@ def write_wear_map(run: Run, out: Path) -> tuple[pa.Table, dict[str, Path]]:
     (``"wear_map"``, ``"wear_map_figure"``). Raises `InputError` when the run lacks a table the map needs."""
     table = wear_map(run)
     figure = wear_figure(table)
-    paths = {"wear_map": out / WEAR_MAP_FILE, "wear_map_figure": out / WEAR_FIGURE_FILE}
-    # both or neither: a run killed while writing them leaves no map without its figure
-    write_all_atomically({
-        paths["wear_map"]: parquet_writer(table),
-        paths["wear_map_figure"]: png_writer(figure),
-    })  # fmt: skip
-    return table, paths
+    return table, write_with_figure("wear_map", table, figure, out, (WEAR_MAP_FILE, WEAR_FIGURE_FILE))
 
 
 def wear_map_markdown(table: pa.Table, spot_hours: float | None) -> str:
