@@ -180,6 +180,11 @@ pub struct Dynamics {
     pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     /// Latched approach speed per pair and slot [m/s]; empty for laws that do not latch.
     latched: Vec<Vec<Option<f64>>>,
+    /// The state of the last evaluation, when [`Dynamics::wrenches_kept`]
+    /// made it (any other evaluation clears it): the recorder and the
+    /// energy check read its points and laws instead of evaluating again.
+    kept: Option<State>,
+    kept_valid: bool,
     /// Number of force evaluations so far.
     pub evaluations: u64,
     /// Deepest penetration and stiffest contact since the last reset.
@@ -327,6 +332,8 @@ impl Dynamics {
                     }
                 })
                 .collect(),
+            kept: None,
+            kept_valid: false,
             evaluations: 0,
             watch: ContactWatch::default(),
         }
@@ -378,6 +385,7 @@ impl Dynamics {
             jac.clear();
         }
         self.evaluations += 1;
+        self.kept_valid = false;
         // 1. applied loads (prescribed bodies collect only what joints and
         // contacts apply to them: the reaction on a drive)
         for (i, b) in model.bodies.iter().enumerate() {
@@ -492,6 +500,29 @@ impl Dynamics {
         self.loads_joints_contacts(model, state, mode, None);
     }
 
+    /// [`Dynamics::wrenches`] at a state that is handed out as a frame, its
+    /// points and laws kept for [`Dynamics::all_contact_points`] and
+    /// [`Dynamics::energy`] at that state (until the next evaluation).
+    pub fn wrenches_kept(&mut self, model: &Model, state: &State) {
+        self.wrenches(model, state, Mode::Trial);
+        match &mut self.kept {
+            Some(kept) => kept.clone_from(state),
+            None => self.kept = Some(state.clone()),
+        }
+        self.kept_valid = true;
+    }
+
+    /// Whether the last evaluation was [`Dynamics::wrenches_kept`] at
+    /// `state` (its time rounded by the caller: the points and laws do not
+    /// depend on the time).
+    fn kept_at(&self, state: &State) -> bool {
+        self.kept_valid
+            && self
+                .kept
+                .as_ref()
+                .is_some_and(|k| k.is_at(state, 1e-12 * state.t.abs().max(1.0)))
+    }
+
     /// Forces and their velocity Jacobian at `state`, for implicit integrators.
     ///
     /// One force evaluation through the same path as
@@ -562,9 +593,44 @@ impl Dynamics {
         self.points = points;
     }
 
-    /// Kinetic, gravitational and elastic contact energy at `state`.
+    /// Every pair's contact points at `state` (`out[k]` for pair k, each
+    /// cleared first), as [`Dynamics::contact_points`] gives them: read from
+    /// the last evaluation where it was kept at `state`, the same to the bit.
+    pub fn all_contact_points(
+        &mut self,
+        model: &Model,
+        state: &State,
+        out: &mut [Vec<ContactEval>],
+    ) {
+        let kept = self.kept_at(state);
+        for (k, out) in out.iter_mut().enumerate() {
+            out.clear();
+            if kept {
+                let e = &self.pairs[k];
+                out.extend(
+                    e.points
+                        .iter()
+                        .zip(&e.laws)
+                        .map(|(p, (law, _))| ContactEval::new(*p, law)),
+                );
+            } else {
+                self.contact_points(model, state, k, out);
+            }
+        }
+    }
+
+    /// Kinetic, gravitational and elastic contact energy at `state` (the
+    /// contact points read from the last evaluation where it was kept at
+    /// `state`).
     pub fn energy(&mut self, model: &Model, state: &State) -> Energy {
-        energy_of(model, state, &mut self.points)
+        if !self.kept_at(state) {
+            return energy_of(model, state, &mut self.points);
+        }
+        let mut e = bodies_energy(model, state);
+        for (pair, p) in model.pairs.iter().zip(&self.pairs) {
+            e.potential_contact += elastic_energy(pair, &p.points);
+        }
+        e
     }
 }
 
@@ -592,6 +658,17 @@ pub fn pair_with_infinite_energy<'m>(model: &'m Model, state: &State) -> Option<
 /// The energy of `state` (see [`Dynamics::energy`]), with `points` as the
 /// contact points' scratch buffer: no [`Dynamics`] (and no thread pool) needed.
 pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -> Energy {
+    let mut e = bodies_energy(model, state);
+    for pair in &model.pairs {
+        find_points(model, pair, state, points);
+        e.potential_contact += elastic_energy(pair, points);
+    }
+    e
+}
+
+/// The bodies' kinetic and gravitational energy at `state`, no contact
+/// energy yet.
+fn bodies_energy(model: &Model, state: &State) -> Energy {
     let mut kinetic = 0.0;
     let mut potential_gravity = 0.0;
     for &i in &model.integrated {
@@ -599,19 +676,19 @@ pub fn energy_of(model: &Model, state: &State, points: &mut Vec<ContactPoint>) -
         kinetic += k;
         potential_gravity += g;
     }
-    let mut potential_contact = 0.0;
-    for pair in &model.pairs {
-        find_points(model, pair, state, points);
-        potential_contact += points
-            .iter()
-            .map(|p| p.weight * pair.normal.elastic_energy(p.depth))
-            .sum::<f64>();
-    }
     Energy {
         kinetic,
         potential_gravity,
-        potential_contact,
+        potential_contact: 0.0,
     }
+}
+
+/// The elastic energy of `pair`'s contact `points` [J].
+fn elastic_energy(pair: &ContactPair, points: &[ContactPoint]) -> f64 {
+    points
+        .iter()
+        .map(|p| p.weight * pair.normal.elastic_energy(p.depth))
+        .sum()
 }
 
 /// Stage 3 for pair `k`, on its own: finds its points, latches onsets in

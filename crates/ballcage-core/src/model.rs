@@ -342,6 +342,15 @@ impl Clone for State {
 }
 
 impl State {
+    /// Whether `other` is this state: the same poses and velocities to the
+    /// bit, its time within `time_tolerance` [s] (callers round the time to
+    /// their step count).
+    pub fn is_at(&self, other: &State, time_tolerance: f64) -> bool {
+        (self.t - other.t).abs() <= time_tolerance
+            && (&self.pos, &self.rot, &self.vel, &self.omega)
+                == (&other.pos, &other.rot, &other.vel, &other.omega)
+    }
+
     /// Angular velocity of body `i` in the world frame [rad/s].
     pub fn omega_world(&self, i: usize) -> Vec3 {
         self.rot[i] * self.omega[i]

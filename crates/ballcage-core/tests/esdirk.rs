@@ -473,3 +473,136 @@ fn prothero_robinson_errors(integrator: &str) -> Vec<f64> {
     }
     errors
 }
+
+/// A ball landing on a floor, sliding, whose contact laws are `normal` (and
+/// any `friction` after it), under `esdirk32` with
+/// the `[simulation]` keys `simulation` (0.1 s).
+fn landing(normal: &str, simulation: &str) -> Simulation {
+    common::sim(&format!(
+        r#"
+        [simulation]
+        duration = 0.1
+        integrator = "esdirk32"
+        {simulation}
+        [world]
+        gravity = [0.0, 0.0, -9.81]
+        [record]
+        tables = []
+        [[bodies]]
+        name = "floor"
+        motion = "fixed"
+        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
+        [[bodies]]
+        name = "ball"
+        shape = {{ type = "ball", radius = 0.05 }}
+        mass = 1.0
+        position = [0.0, 0.0, 0.0499]
+        velocity = [0.05, 0.0, -0.2]
+        [[contacts]]
+        bodies = ["floor", "ball"]
+        normal = {normal}
+        "#
+    ))
+}
+
+/// Force evaluations beyond one per Newton iteration: those of the steps'
+/// first stages (and of frames interpolated within a step).
+fn first_stage_evaluations(sim: &Simulation) -> u64 {
+    sim.force_evaluations() - sim.solver_stats().newton_iterations
+}
+
+#[test]
+fn the_first_stage_is_the_last_stage_of_the_step_before() {
+    // Fixed steps of 1 ms, frames on the steps: only the run's first step
+    // evaluates its start; every later one starts from the step before's
+    // A_4 (stiffly accurate), which the third-order tests above check.
+    let linear = "{ law = \"linear\", stiffness = 1e4, damping = 20.0 }";
+    let mut sim = landing(linear, "dt = 1e-3\noutput_interval = 1e-3");
+    sim.run().unwrap();
+    assert_eq!(sim.steps(), 100);
+    assert_eq!(first_stage_evaluations(&sim), 1);
+    // Adaptive steps, one frame at the end (interpolated: one evaluation
+    // there): a step retried smaller reuses its start's A_1 too.
+    let mut sim = landing(linear, "dt = 0.1\noutput_interval = 0.1\nrtol = 1e-6");
+    sim.run().unwrap();
+    let e = sim.error_stats().expect("an estimate");
+    assert!(e.rejected > 0 && e.accepted > 20, "{e:?}");
+    assert!(
+        first_stage_evaluations(&sim) <= 2,
+        "{} evaluations beyond Newton's over {} steps",
+        first_stage_evaluations(&sim),
+        e.accepted + e.rejected
+    );
+}
+
+#[test]
+fn laws_with_memory_evaluate_every_start_to_latch_onsets() {
+    // Hunt–Crossley latches the approach speed at each onset, which only a
+    // force evaluation at an accepted start does: no step skips it.
+    let hunt = "{ law = \"hunt-crossley\", stiffness = 1e6, exponent = 1.5, restitution = 0.7 }";
+    let mut sim = landing(hunt, "dt = 1e-3\noutput_interval = 1e-3");
+    sim.run().unwrap();
+    assert_eq!(first_stage_evaluations(&sim), 100);
+}
+
+#[test]
+fn a_frame_s_contacts_are_read_from_the_evaluation_kept_there() {
+    use ballcage_core::dynamics::Dynamics;
+    // Two states of a ball bouncing on a sliding floor contact (friction:
+    // tangential laws too), one frame apart.
+    let law = "{ law = \"linear\", stiffness = 1e4, damping = 20.0 }\n\
+               friction = { law = \"tanh\", mu = 0.3, v_ref = 0.01 }";
+    let mut sim = landing(law, "dt = 1e-3\noutput_interval = 1e-3\nrtol = 1e-4");
+    sim.step().unwrap();
+    let s1 = sim.state().clone();
+    sim.step().unwrap();
+    let s2 = sim.state().clone();
+    let model = sim.model();
+    let fresh = |state| {
+        let mut d = Dynamics::new(model);
+        let mut out = vec![Vec::new(); model.pairs.len()];
+        for (k, o) in out.iter_mut().enumerate() {
+            d.contact_points(model, state, k, o);
+        }
+        (format!("{out:?}"), d.energy(model, state))
+    };
+    let (at_1, energy_1) = fresh(&s1);
+    let (at_2, _) = fresh(&s2);
+    assert_ne!(
+        at_1, at_2,
+        "the two frames must differ for the test to mean anything"
+    );
+    assert!(
+        at_1.contains("normal_force"),
+        "no contact at frame 1: {at_1}"
+    );
+    assert!(
+        !at_1.contains("slip_speed: 0.0 "),
+        "no sliding at frame 1: {at_1}"
+    );
+    let mut d = Dynamics::new(model);
+    let mut out = vec![Vec::new(); model.pairs.len()];
+    // Kept at s1: read back, the same to the bit as a fresh evaluation.
+    d.wrenches_kept(model, &s1);
+    let evaluations = d.evaluations;
+    d.all_contact_points(model, &s1, &mut out);
+    assert_eq!(format!("{out:?}"), at_1);
+    assert_eq!(
+        format!("{:?}", d.energy(model, &s1)),
+        format!("{energy_1:?}")
+    );
+    assert_eq!(d.evaluations, evaluations);
+    // Another evaluation since (at s2): s1 is evaluated afresh, not read
+    // from what the pairs now hold.
+    d.wrenches(model, &s2, ballcage_core::dynamics::Mode::Trial);
+    d.all_contact_points(model, &s1, &mut out);
+    assert_eq!(format!("{out:?}"), at_1);
+    assert_eq!(
+        format!("{:?}", d.energy(model, &s1)),
+        format!("{energy_1:?}")
+    );
+    // And a state it was not kept at is evaluated afresh too.
+    d.wrenches_kept(model, &s1);
+    d.all_contact_points(model, &s2, &mut out);
+    assert_eq!(format!("{out:?}"), at_2);
+}

@@ -185,6 +185,12 @@ pub(super) struct Stages {
     handed_valid: bool,
     /// The last accepted step, for the frames within it.
     dense: Dense,
+    /// Stage 1's A_1 known without a force evaluation ([`Implicit::first_stage`]):
+    /// the state whose A_1 `acc[0]` holds (the last step's start), and the
+    /// end of the last step taken with its A_4.
+    known_start: Option<State>,
+    known_end: Option<State>,
+    end_acc: Vec<f64>,
     /// The step the controller proposes next [s] (0 before the first).
     h_next: f64,
     /// The last accepted step's error norm, and whether the last attempt
@@ -197,6 +203,7 @@ pub(super) struct Stages {
 impl Stages {
     fn new(n: usize) -> Self {
         let z = vec![0.0; n];
+        let z_end = z.clone();
         Self {
             acc: [z.clone(), z.clone(), z.clone(), z.clone()],
             rate: [z.clone(), z.clone(), z.clone(), z.clone()],
@@ -209,6 +216,9 @@ impl Stages {
             handed: None,
             handed_valid: false,
             dense: Dense::new(n),
+            known_start: None,
+            known_end: None,
+            end_acc: z_end,
             h_next: 0.0,
             err_last: 1.0,
             rejected_last: false,
@@ -325,14 +335,7 @@ impl Implicit {
     /// frame (nothing changed it since); else `state`.
     fn own_state(&mut self, state: &State, big: f64) -> State {
         let es = self.esdirk.as_mut().expect("made by esdirk_step");
-        // (The caller rounds the time to its step count: compared apart.)
-        let unchanged = |handed: &State| {
-            (handed.t - state.t).abs() <= 1e-9 * big
-                && handed.pos == state.pos
-                && handed.rot == state.rot
-                && handed.vel == state.vel
-                && handed.omega == state.omega
-        };
+        let unchanged = |handed: &State| handed.is_at(state, 1e-9 * big);
         let handed = es.handed.get_or_insert_with(|| state.clone());
         match es.ahead.take() {
             Some(ahead) if es.handed_valid && unchanged(handed) => ahead,
@@ -362,7 +365,7 @@ impl Implicit {
             state.clone_from(&cur);
         } else {
             self.interpolate(model, t_end, state);
-            dynamics.wrenches(model, state, Mode::Trial);
+            dynamics.wrenches_kept(model, state);
         }
         let es = self.esdirk.as_mut().expect("made by esdirk_step");
         es.ahead = Some(cur);
@@ -487,7 +490,7 @@ impl Implicit {
             model.prescribe(state.t, state);
             return Ok(());
         }
-        self.explicit_stage(model, dynamics, state);
+        self.first_stage(model, dynamics, state, h);
         let mut stage = self.stage.take().unwrap_or_else(|| state.clone());
         self.v.copy_from_slice(&self.v_n);
         if !model.newton.reuse_jacobian {
@@ -515,6 +518,9 @@ impl Implicit {
             state.t = stage.t + h;
             model.prescribe(state.t, state);
             stage.clone_from(state);
+            let es = self.esdirk.as_mut().expect("made by esdirk_step");
+            es.end_acc.copy_from_slice(&es.acc[3]);
+            keep(&mut es.known_end, state);
             if model.tolerance.is_none() {
                 self.note_accepted(h);
             }
@@ -523,8 +529,29 @@ impl Implicit {
         result
     }
 
-    /// Stage 1: v_n, and A_1 = M⁻¹(f − ω×I_wω) from one force evaluation
-    /// at the start (which also latches contact onsets there).
+    /// Stage 1: v_n, and A_1 = M⁻¹(f − ω×I_wω) at the start, from a force
+    /// evaluation only where it is not known already (first same as last):
+    /// at the end of the step just taken, A_1 is that step's A_4 (the method
+    /// is stiffly accurate: stage 4 is the new start, and A_4 solves its
+    /// stage equation, M·A_4 = f − ω×I_wω at stage 4, to Newton's tolerance);
+    /// at the start of a step retried smaller, it is the A_1 of the attempt
+    /// before. Laws with memory latch their onsets at every start
+    /// ([`Mode::Commit`]), so those scenes evaluate at every start.
+    fn first_stage(&mut self, model: &Model, dynamics: &mut Dynamics, state: &State, h: f64) {
+        let es = self.esdirk.as_mut().expect("made by esdirk_step");
+        let memory = dynamics.has_memory();
+        let at = |kept: &Option<State>| kept.as_ref().is_some_and(|k| k.is_at(state, 1e-9 * h));
+        if !memory && at(&es.known_end) {
+            es.acc[0].copy_from_slice(&es.end_acc);
+        } else if memory || !at(&es.known_start) {
+            self.explicit_stage(model, dynamics, state);
+        }
+        self.gather(model, state);
+        let es = self.esdirk.as_mut().expect("made by esdirk_step");
+        es.rate[0].copy_from_slice(&self.v_n);
+        keep(&mut es.known_start, state);
+    }
+
     fn explicit_stage(&mut self, model: &Model, dynamics: &mut Dynamics, state: &State) {
         dynamics.wrenches(model, state, Mode::Commit);
         self.gather(model, state);
@@ -558,7 +585,6 @@ impl Implicit {
                 }
             }
         }
-        es.rate[0].copy_from_slice(&self.v_n);
     }
 
     /// The known parts of stage `s`: h·Σ_{j<s} a_sj·A_j and Σ_{j<s} a_sj·rate_j.
@@ -718,6 +744,14 @@ fn too_small(h: f64, big: f64) -> Option<String> {
             (1.0 / MIN_STEP_FRACTION) as u64
         )
     })
+}
+
+/// Keeps a copy of `state` in `slot`, reusing its memory.
+fn keep(slot: &mut Option<State>, state: &State) {
+    match slot {
+        Some(kept) => kept.clone_from(state),
+        None => *slot = Some(state.clone()),
+    }
 }
 
 #[cfg(test)]

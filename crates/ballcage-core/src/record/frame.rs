@@ -189,10 +189,7 @@ impl Recorder {
 
     /// Every pair's contact points with their forces at `state`, into `evals`.
     fn evaluate(&mut self, model: &Model, state: &State, dynamics: &mut Dynamics) {
-        for (k, out) in self.evals.iter_mut().enumerate() {
-            out.clear();
-            dynamics.contact_points(model, state, k, out);
-        }
+        dynamics.all_contact_points(model, state, &mut self.evals);
     }
 
     /// Integrates what the `energy` table and the observers read every step
