@@ -505,10 +505,7 @@ impl Dynamics {
     /// [`Dynamics::energy`] at that state (until the next evaluation).
     pub fn wrenches_kept(&mut self, model: &Model, state: &State) {
         self.wrenches(model, state, Mode::Trial);
-        match &mut self.kept {
-            Some(kept) => kept.clone_from(state),
-            None => self.kept = Some(state.clone()),
-        }
+        state.copy_into(&mut self.kept);
         self.kept_valid = true;
     }
 

@@ -351,6 +351,15 @@ impl State {
                 == (&other.pos, &other.rot, &other.vel, &other.omega)
     }
 
+    /// Copies this state into `slot`, reusing the memory of the state
+    /// already there (no allocation after the first).
+    pub fn copy_into(&self, slot: &mut Option<State>) {
+        match slot {
+            Some(kept) => kept.clone_from(self),
+            None => *slot = Some(self.clone()),
+        }
+    }
+
     /// Angular velocity of body `i` in the world frame [rad/s].
     pub fn omega_world(&self, i: usize) -> Vec3 {
         self.rot[i] * self.omega[i]

@@ -86,35 +86,21 @@ fn third_order_on_the_rotation_manifold() {
 fn hertz(dt: f64) -> Simulation {
     let (m, k, g) = (0.014f64, 1e9f64, 100.0 / 0.014);
     let rest = (m * g / k).powf(1.0 / 1.5);
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.01
-        dt = {dt}
-        output_interval = 0.01
-        integrator = "esdirk32"
-        newton = {{ tolerance = 1e-14 }}
-        [world]
-        gravity = [0.0, 0.0, {neg_g}]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = 0.0075 }}
-        mass = {m}
-        position = [0.0, 0.0, {z0}]
-        velocity = [0.0, 0.0, -0.02]
-        [[contacts]]
-        bodies = ["floor", "ball"]
-        normal = {{ law = "impact", stiffness = {k}, exponent = 1.5, damping = 0.0, depth_max = 1e-3 }}
-        "#,
-        neg_g = -g,
-        z0 = 0.0075 - rest,
-    ))
+    common::ball_on_floor(
+        &format!(
+            "duration = 0.01\ndt = {dt}\noutput_interval = 0.01\nintegrator = \"esdirk32\"\n\
+             newton = {{ tolerance = 1e-14 }}"
+        ),
+        g,
+        &format!(
+            "shape = {{ type = \"ball\", radius = 0.0075 }}\nmass = {m}\n\
+             position = [0.0, 0.0, {z0}]\nvelocity = [0.0, 0.0, -0.02]",
+            z0 = 0.0075 - rest
+        ),
+        &format!(
+            "normal = {{ law = \"impact\", stiffness = {k}, exponent = 1.5, damping = 0.0, depth_max = 1e-3 }}"
+        ),
+    )
 }
 
 /// The relative energy error at the end of a Hertz run.
@@ -478,31 +464,13 @@ fn prothero_robinson_errors(integrator: &str) -> Vec<f64> {
 /// any `friction` after it), under `esdirk32` with
 /// the `[simulation]` keys `simulation` (0.1 s).
 fn landing(normal: &str, simulation: &str) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.1
-        integrator = "esdirk32"
-        {simulation}
-        [world]
-        gravity = [0.0, 0.0, -9.81]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = 0.05 }}
-        mass = 1.0
-        position = [0.0, 0.0, 0.0499]
-        velocity = [0.05, 0.0, -0.2]
-        [[contacts]]
-        bodies = ["floor", "ball"]
-        normal = {normal}
-        "#
-    ))
+    common::ball_on_floor(
+        &format!("duration = 0.1\nintegrator = \"esdirk32\"\n{simulation}"),
+        9.81,
+        "shape = { type = \"ball\", radius = 0.05 }\nmass = 1.0\n\
+         position = [0.0, 0.0, 0.0499]\nvelocity = [0.05, 0.0, -0.2]",
+        &format!("normal = {normal}"),
+    )
 }
 
 /// Force evaluations beyond one per Newton iteration: those of the steps'

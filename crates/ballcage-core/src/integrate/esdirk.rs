@@ -520,7 +520,7 @@ impl Implicit {
             stage.clone_from(state);
             let es = self.esdirk.as_mut().expect("made by esdirk_step");
             es.end_acc.copy_from_slice(&es.acc[3]);
-            keep(&mut es.known_end, state);
+            state.copy_into(&mut es.known_end);
             if model.tolerance.is_none() {
                 self.note_accepted(h);
             }
@@ -549,7 +549,7 @@ impl Implicit {
         self.gather(model, state);
         let es = self.esdirk.as_mut().expect("made by esdirk_step");
         es.rate[0].copy_from_slice(&self.v_n);
-        keep(&mut es.known_start, state);
+        state.copy_into(&mut es.known_start);
     }
 
     fn explicit_stage(&mut self, model: &Model, dynamics: &mut Dynamics, state: &State) {
@@ -744,14 +744,6 @@ fn too_small(h: f64, big: f64) -> Option<String> {
             (1.0 / MIN_STEP_FRACTION) as u64
         )
     })
-}
-
-/// Keeps a copy of `state` in `slot`, reusing its memory.
-fn keep(slot: &mut Option<State>, state: &State) {
-    match slot {
-        Some(kept) => kept.clone_from(state),
-        None => *slot = Some(state.clone()),
-    }
 }
 
 #[cfg(test)]

@@ -100,13 +100,30 @@ pub fn incline_scene(
 /// ([`oscillator_exact`]). `simulation`: the `[simulation]` keys besides
 /// the duration (0.1 s).
 pub fn oscillator(simulation: &str) -> Simulation {
+    ball_on_floor(
+        &format!("duration = 0.1\n{simulation}"),
+        9.81,
+        &format!(
+            "shape = {{ type = \"ball\", radius = 0.05 }}\nmass = 1.0\n\
+             position = [0.0, 0.0, {z0}]\nvelocity = [0.0, 0.0, 0.05]",
+            z0 = 0.05 - 9.81e-4
+        ),
+        "normal = { law = \"linear\", stiffness = 1e4, damping = 20.0 }",
+    )
+}
+
+/// A body named "ball" on a fixed floor (the half-space z ≤ 0, body
+/// "floor") under gravity `g` [m/s²] along −z, no tables recorded:
+/// `simulation` the `[simulation]` keys, `ball` the ball's keys besides its
+/// name (shape, mass, position, velocity), `contact` the floor–ball
+/// contact's keys besides its bodies (its laws).
+pub fn ball_on_floor(simulation: &str, g: f64, ball: &str, contact: &str) -> Simulation {
     sim(&format!(
         r#"
         [simulation]
-        duration = 0.1
         {simulation}
         [world]
-        gravity = [0.0, 0.0, -9.81]
+        gravity = [0.0, 0.0, {neg_g}]
         [record]
         tables = []
         [[bodies]]
@@ -115,15 +132,12 @@ pub fn oscillator(simulation: &str) -> Simulation {
         shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
         [[bodies]]
         name = "ball"
-        shape = {{ type = "ball", radius = 0.05 }}
-        mass = 1.0
-        position = [0.0, 0.0, {z0}]
-        velocity = [0.0, 0.0, 0.05]
+        {ball}
         [[contacts]]
         bodies = ["floor", "ball"]
-        normal = {{ law = "linear", stiffness = 1e4, damping = 20.0 }}
+        {contact}
         "#,
-        z0 = 0.05 - 9.81e-4,
+        neg_g = -g,
     ))
 }
 
