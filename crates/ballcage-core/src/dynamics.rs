@@ -10,11 +10,13 @@
 
 use crate::force::friction_force;
 use crate::force::joint::twist_axis;
-use crate::geometry::{CentreMotion, ContactPoint, Rim, Slide};
+use crate::geometry::{CentreMotion, ContactPoint, PointSink, Rim, Slide};
+
+mod table;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
 use nalgebra::Vector6;
-use rayon::prelude::*;
+use table::{ContactTable, PairSlots};
 
 /// Accelerations of every body (zero for bodies that are not integrated).
 #[derive(Debug, Clone, PartialEq)]
@@ -156,15 +158,6 @@ impl Energy {
     }
 }
 
-/// One pair's contact points with their laws evaluated, kept until they are
-/// summed in the pairs' order.
-#[derive(Debug, Clone, Default)]
-struct PairEval {
-    points: Vec<ContactPoint>,
-    /// The laws at each of `points`.
-    laws: Vec<(PointLaw, PointDerivatives)>,
-}
-
 /// Force evaluator with its scratch space and per-contact memory.
 #[derive(Debug, Clone)]
 pub struct Dynamics {
@@ -174,12 +167,11 @@ pub struct Dynamics {
     /// Each body's angular velocity in the world frame at the state being
     /// evaluated [rad/s]: rotated once per body, not once per pair.
     omega_world: Vec<Vec3>,
-    /// Per pair: its points of the current evaluation.
-    pairs: Vec<PairEval>,
+    /// Every pair's points and laws of the current evaluation, and its
+    /// latched approach speeds [m/s] (for laws that latch).
+    table: ContactTable,
     /// Threads that evaluate the pairs (`None`: this thread alone).
     pool: Option<std::sync::Arc<rayon::ThreadPool>>,
-    /// Latched approach speed per pair and slot [m/s]; empty for laws that do not latch.
-    latched: Vec<Vec<Option<f64>>>,
     /// The state of the last evaluation, when [`Dynamics::wrenches_kept`]
     /// made it (any other evaluation clears it): the recorder and the
     /// energy check read its points and laws instead of evaluating again.
@@ -302,14 +294,7 @@ impl Dynamics {
             omega_world: vec![Vec3::zeros(); n],
             // Room for as many points as each pair can report: no
             // allocation when a pair first comes into contact.
-            pairs: model
-                .pairs
-                .iter()
-                .map(|p| PairEval {
-                    points: Vec::with_capacity(p.geometry.slots()),
-                    laws: Vec::with_capacity(p.geometry.slots()),
-                })
-                .collect(),
+            table: ContactTable::new(model),
             // A pool that cannot start leaves the evaluation on this thread:
             // the same results, only slower.
             pool: (model.threads > 1)
@@ -321,17 +306,6 @@ impl Dynamics {
                 })
                 .flatten()
                 .map(std::sync::Arc::new),
-            latched: model
-                .pairs
-                .iter()
-                .map(|p| {
-                    if p.normal.latches_approach_speed() {
-                        vec![None; p.geometry.slots()]
-                    } else {
-                        vec![]
-                    }
-                })
-                .collect(),
             kept: None,
             kept_valid: false,
             evaluations: 0,
@@ -432,44 +406,17 @@ impl Dynamics {
         let n = model.pairs.len();
         let scale = jac.as_ref().map_or(0.0, |j| j.stiffness_scale);
         let omega = &self.omega_world;
-        let one = |k: usize, e: &mut PairEval, l: &mut Vec<Option<f64>>, c| {
-            evaluate_pair(model, (state, omega), mode, k, e, l, c, scale)
-        };
-        let (pairs, latched) = (&mut self.pairs, &mut self.latched);
         // A few tasks per thread: enough to balance, few enough to be cheap.
-        let chunk = n.div_ceil(4 * self.pool.as_ref().map_or(1, |p| p.current_num_threads()));
-        match (&self.pool, jac) {
-            (None, None) => {
-                for (k, (e, l)) in pairs.iter_mut().zip(latched).enumerate() {
-                    one(k, e, l, None);
-                }
-            }
-            (None, Some(jac)) => {
-                let cs = jac.couplings[..n].iter_mut();
-                for (k, ((e, l), c)) in pairs.iter_mut().zip(latched).zip(cs).enumerate() {
-                    one(k, e, l, Some(c));
-                }
-            }
-            (Some(pool), None) => pool.install(|| {
-                pairs
-                    .par_iter_mut()
-                    .zip(latched.par_iter_mut())
-                    .enumerate()
-                    .with_min_len(chunk)
-                    .for_each(|(k, (e, l))| one(k, e, l, None))
-            }),
-            (Some(pool), Some(jac)) => pool.install(|| {
-                pairs
-                    .par_iter_mut()
-                    .zip(latched.par_iter_mut())
-                    .zip(jac.couplings[..n].par_iter_mut())
-                    .enumerate()
-                    .with_min_len(chunk)
-                    .for_each(|(k, ((e, l), c))| one(k, e, l, Some(c)))
-            }),
-        }
-        for (k, (pair, e)) in model.pairs.iter().zip(&self.pairs).enumerate() {
-            for (point, (e, d)) in e.points.iter().zip(&e.laws) {
+        let chunk = n.div_ceil(4 * self.threads());
+        self.table.for_each_pair(
+            jac.map(|j| &mut j.couplings[..]),
+            self.pool.as_deref(),
+            chunk,
+            |k, slots| evaluate_pair(model, (state, omega), mode, k, slots, scale),
+        );
+        for (k, pair) in model.pairs.iter().enumerate() {
+            let (points, laws) = self.table.pair(k);
+            for (point, (e, d)) in points.iter().zip(laws) {
                 self.watch.see(k, pair, point.depth, e, d);
                 let (f, p) = (e.force(point), point.point);
                 let (a, b) = (pair.a, pair.b);
@@ -489,7 +436,7 @@ impl Dynamics {
     /// Whether some pair keeps per-contact memory (latched approach speeds),
     /// which only [`Mode::Commit`] evaluations update.
     pub fn has_memory(&self) -> bool {
-        self.latched.iter().any(|l| !l.is_empty())
+        self.table.has_memory()
     }
 
     /// Net force and torque on every body at `state` (world frame, torques
@@ -585,7 +532,7 @@ impl Dynamics {
         out.extend(
             points
                 .iter()
-                .map(|p| evaluate_point(state, pair, p, &self.latched[k])),
+                .map(|p| evaluate_point(state, pair, p, self.table.latched(k))),
         );
         self.points = points;
     }
@@ -603,11 +550,11 @@ impl Dynamics {
         for (k, out) in out.iter_mut().enumerate() {
             out.clear();
             if kept {
-                let e = &self.pairs[k];
+                let (points, laws) = self.table.pair(k);
                 out.extend(
-                    e.points
+                    points
                         .iter()
-                        .zip(&e.laws)
+                        .zip(laws)
                         .map(|(p, (law, _))| ContactEval::new(*p, law)),
                 );
             } else {
@@ -624,8 +571,8 @@ impl Dynamics {
             return energy_of(model, state, &mut self.points);
         }
         let mut e = bodies_energy(model, state);
-        for (pair, p) in model.pairs.iter().zip(&self.pairs) {
-            e.potential_contact += elastic_energy(pair, &p.points);
+        for (k, pair) in model.pairs.iter().enumerate() {
+            e.potential_contact += elastic_energy(pair, self.table.pair(k).0);
         }
         e
     }
@@ -688,24 +635,23 @@ fn elastic_energy(pair: &ContactPair, points: &[ContactPoint]) -> f64 {
         .sum()
 }
 
-/// Stage 3 for pair `k`, on its own: finds its points, latches onsets in
-/// [`Mode::Commit`], evaluates the laws into `e` and, with `c`, fills the
-/// pair's Jacobian blocks (stiffness weight `scale`).
-#[allow(clippy::too_many_arguments)]
+/// Stage 3 for pair `k`, on its own: finds its points into its `slots`,
+/// latches onsets in [`Mode::Commit`], evaluates the laws and, with the
+/// slots' coupling, fills the pair's Jacobian blocks (stiffness weight
+/// `scale`).
 fn evaluate_pair(
     model: &Model,
     (state, omega_world): (&State, &[Vec3]),
     mode: Mode,
     k: usize,
-    e: &mut PairEval,
-    latched: &mut [Option<f64>],
-    mut c: Option<&mut CouplingJacobian>,
+    slots: &mut PairSlots,
     scale: f64,
 ) {
     let pair = &model.pairs[k];
-    find_points(model, pair, state, &mut e.points);
-    e.laws.clear();
-    if e.points.is_empty() {
+    find_points(model, pair, state, &mut slots.points);
+    let points = &slots.points.slots[..slots.points.len];
+    let latched = &mut *slots.latched;
+    if points.is_empty() {
         // Most pairs, most of the time: nothing to evaluate, and nothing latched.
         if mode == Mode::Commit {
             latched.fill(None);
@@ -714,14 +660,14 @@ fn evaluate_pair(
     }
     let motion = PairMotion::of(state, pair, |i| omega_world[i]);
     if mode == Mode::Commit {
-        latch(latched, &motion, &e.points);
+        latch(latched, &motion, points);
     }
-    for p in &e.points {
-        let (law, d) = evaluate_point_full(&motion, pair, p, latched);
-        if let Some(c) = c.as_deref_mut() {
-            c.add_contact_point(state, pair, p, &law, &d, scale);
+    for (p, law) in points.iter().zip(slots.laws.iter_mut()) {
+        let (l, d) = evaluate_point_full(&motion, pair, p, latched);
+        if let Some(c) = slots.coupling.as_deref_mut() {
+            c.add_contact_point(state, pair, p, &l, &d, scale);
         }
-        e.laws.push((law, d));
+        *law = (l, d);
     }
 }
 
@@ -752,7 +698,7 @@ fn latch(latched: &mut [Option<f64>], motion: &PairMotion, points: &[ContactPoin
 }
 
 /// Contact points of a pair in the (a, b) convention.
-fn find_points(model: &Model, pair: &ContactPair, state: &State, out: &mut Vec<ContactPoint>) {
+fn find_points(model: &Model, pair: &ContactPair, state: &State, out: &mut dyn PointSink) {
     out.clear();
     let (first, second) = if pair.swapped {
         (pair.b, pair.a)
@@ -767,7 +713,7 @@ fn find_points(model: &Model, pair: &ContactPair, state: &State, out: &mut Vec<C
         out,
     );
     if pair.swapped {
-        for p in out.iter_mut() {
+        for p in out.filled() {
             p.normal = -p.normal;
             p.turning = p.turning.swapped();
         }

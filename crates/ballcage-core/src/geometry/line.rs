@@ -30,7 +30,8 @@ use ballcage_shapes::{Rod, TubeInterior};
 use parry3d_f64::math::Vector;
 
 use super::{
-    CentreMotion, ContactPoint, LineContact, LineLaw, NormalTurning, Rim, Slide, TubePath,
+    CentreMotion, ContactPoint, LineContact, LineLaw, NormalTurning, PointSink, Rim, Slide,
+    TubePath,
 };
 use crate::math::{Quat, Vec3, from_glam, to_glam};
 use ballcage_shapes::line::Extremum;
@@ -46,7 +47,7 @@ pub(super) fn cylinder_tube(
     half_length: f64,
     line: LineContact,
     pc: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let inv = pt.1.inverse();
     let rod = Rod {

@@ -111,6 +111,89 @@ pub struct ContactPoint {
     pub turning: NormalTurning,
 }
 
+/// Where a pair's contact query puts the points it finds: a `Vec`, or the
+/// pair's fixed range of slots in the engine's flat per-contact arrays
+/// ([`SlotSink`]).
+pub trait PointSink {
+    /// Appends one point.
+    fn push(&mut self, point: ContactPoint);
+
+    /// Forgets every point.
+    fn clear(&mut self);
+
+    /// The points appended since the last [`PointSink::clear`].
+    fn filled(&mut self) -> &mut [ContactPoint];
+
+    /// Appends `point` if there is one.
+    #[inline]
+    fn push_some(&mut self, point: Option<ContactPoint>) {
+        if let Some(p) = point {
+            self.push(p);
+        }
+    }
+}
+
+impl PointSink for Vec<ContactPoint> {
+    #[inline]
+    fn push(&mut self, point: ContactPoint) {
+        Vec::push(self, point);
+    }
+
+    fn clear(&mut self) {
+        Vec::clear(self);
+    }
+
+    fn filled(&mut self) -> &mut [ContactPoint] {
+        self
+    }
+}
+
+/// A pair's range of slots in a flat array, filled from its start: it holds
+/// as many points as [`PairGeometry::slots`] says the pair can report.
+#[derive(Debug)]
+pub struct SlotSink<'a> {
+    /// The pair's slots.
+    pub slots: &'a mut [ContactPoint],
+    /// How many are filled.
+    pub len: usize,
+}
+
+impl PointSink for SlotSink<'_> {
+    #[inline]
+    fn push(&mut self, point: ContactPoint) {
+        // A query reports at most `PairGeometry::slots` points: a pair that
+        // reported more would be a geometry bug, caught here.
+        self.slots[self.len] = point;
+        self.len += 1;
+    }
+
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    fn filled(&mut self) -> &mut [ContactPoint] {
+        &mut self.slots[..self.len]
+    }
+}
+
+impl ContactPoint {
+    /// A slot not in use (all zeros): what flat per-contact arrays are
+    /// filled with before any evaluation.
+    pub const UNUSED: Self = Self {
+        slot: 0,
+        point: Vec3::new(0.0, 0.0, 0.0),
+        normal: Vec3::new(0.0, 0.0, 0.0),
+        depth: 0.0,
+        weight: 0.0,
+        turning: NormalTurning {
+            centre: Vec3::new(0.0, 0.0, 0.0),
+            curvature: Mat3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0),
+            centre_on_b: true,
+            motion: CentreMotion::Fixed,
+        },
+    };
+}
+
 /// How a contact point's normal turns as the bodies move: the data of the
 /// geometric terms of the force Jacobian (`dynamics::CouplingJacobian`).
 ///
@@ -376,7 +459,7 @@ impl PairGeometry {
         p1: (&Vec3, &Quat),
         s2: &Shape,
         p2: (&Vec3, &Quat),
-        out: &mut Vec<ContactPoint>,
+        out: &mut dyn PointSink,
     ) {
         match (self, s1, s2) {
             (Self::ParryConvex, _, _) => parry_convex(s1, p1, s2, p2, out),
@@ -447,7 +530,7 @@ fn parry_convex(
     p1: (&Vec3, &Quat),
     s2: &Shape,
     p2: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let (Some(g1), Some(g2)) = (parry_shape(s1), parry_shape(s2)) else {
         return;
@@ -509,7 +592,7 @@ fn cuboid_half_space(
     pc: (&Vec3, &Quat),
     h: &HalfSpace,
     ph: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let n = ph.1 * from_glam(h.normal);
     let he = from_glam(c.half_extents);
@@ -562,7 +645,7 @@ fn ball_tube(
     pt: (&Vec3, &Quat),
     radius: f64,
     pb: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let inside = t.interior();
     let centre = to_glam(&(pt.1.inverse() * (pb.0 - pt.0)));
@@ -572,7 +655,7 @@ fn ball_tube(
             pt.1 * from_glam(core.tangent),
             pt.1 * from_glam(core.curvature),
         );
-        out.extend(placed(c, pt, |n| {
+        out.push_some(placed(c, pt, |n| {
             NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
         }));
     }
@@ -588,7 +671,7 @@ fn torus_ball(
     ball_radius: f64,
     pa: (&Vec3, &Quat),
     pb: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let flank = GrooveFlank {
         centre: to_glam(centre),
@@ -603,7 +686,7 @@ fn torus_ball(
         let dir = (r - r.dot(axis) * axis).normalize();
         let rho = c.depth + flank.tube_radius - ball_radius;
         let (tangent, kappa) = (pa.1 * axis.cross(&dir), pa.1 * (-dir / core_radius));
-        out.extend(placed(c, pa, |n| {
+        out.push_some(placed(c, pa, |n| {
             NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
         }));
     }
@@ -617,7 +700,7 @@ fn slot_ball(
     ball_radius: f64,
     pa: (&Vec3, &Quat),
     pb: (&Vec3, &Quat),
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let slot = WindowSlot {
         centre: to_glam(centre),
@@ -625,7 +708,7 @@ fn slot_ball(
         half_width,
     };
     let p = pa.1.inverse() * (pb.0 - pa.0);
-    out.extend(placed(
+    out.push_some(placed(
         slot.ball_contact(to_glam(&p), ball_radius),
         pa,
         |_| NormalTurning::plane(*pb.0),
@@ -638,7 +721,7 @@ fn cavity_sphere(
     cavity_radius: f64,
     ob: &Vec3,
     sphere_radius: f64,
-    out: &mut Vec<ContactPoint>,
+    out: &mut dyn PointSink,
 ) {
     let cavity = SphericalCavity::new(to_glam(oa), cavity_radius);
     // Already in the world frame.

@@ -13,7 +13,7 @@
 //! and √g = ρ·cos t − h·sin t (docs/model.md §3): the
 //! closed form the tests check.
 
-use super::{CentreMotion, ContactPoint, NormalTurning, Slide};
+use super::{CentreMotion, ContactPoint, NormalTurning, PointSink, Slide};
 use crate::math::{Mat3, Quat, Vec3};
 
 /// The ring (on body a) and the cylinder (on body b) in their bodies' frames.
@@ -37,7 +37,7 @@ impl RingCylinder {
     /// Appends the contact of the cylinder (body b) with the ring (body a),
     /// if they overlap. The normal points from the ring toward the axis,
     /// pushing the cylinder away from the ring.
-    pub fn contacts(&self, pa: (&Vec3, &Quat), pb: (&Vec3, &Quat), out: &mut Vec<ContactPoint>) {
+    pub fn contacts(&self, pa: (&Vec3, &Quat), pb: (&Vec3, &Quat), out: &mut dyn PointSink) {
         let o = pa.0 + pa.1 * self.ring_centre;
         let e = pa.1 * self.ring_axis;
         let p = pb.0 + pb.1 * self.axis_point;
@@ -63,7 +63,7 @@ impl RingCylinder {
 
     /// The search of [`Self::contacts`] at the world poses: ring centre `o`
     /// and normal `e`, cylinder axis point `p` and direction `a`.
-    fn search(&self, o: &Vec3, e: &Vec3, p: &Vec3, a: &Vec3, out: &mut Vec<ContactPoint>) {
+    fn search(&self, o: &Vec3, e: &Vec3, p: &Vec3, a: &Vec3, out: &mut dyn PointSink) {
         let (o, e, p, a) = (*o, *e, *p, *a);
         let (e1, e2) = plane_basis(&e);
         let ring = |phi: f64| o + self.ring_radius * (phi.cos() * e1 + phi.sin() * e2);
