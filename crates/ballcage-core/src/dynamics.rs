@@ -678,8 +678,9 @@ fn latch(latched: &mut [Option<f64>], motion: &PairMotion, points: &[ContactPoin
     if latched.is_empty() {
         return;
     }
-    // Slots of a pair stay below 128: 64 samples, and 2·64 − 1 for the level-set line law.
-    let mut seen = [false; 128];
+    // Slots of a pair stay below 130: 64 samples, and 2·64 + 2 for the
+    // level-set line law (its extrema and the tube's two open ends).
+    let mut seen = [false; 130];
     for p in points {
         let rate = -motion.relative_velocity(&p.point).dot(&p.normal);
         let slot = p.slot as usize;

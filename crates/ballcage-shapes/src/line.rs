@@ -587,6 +587,10 @@ pub enum Extremum {
     Maximum,
     /// An interior local minimum of the depth (a dip between two maxima).
     Minimum,
+    /// A local maximum of the depth where the rod leaves the lumen through
+    /// one of its open ends: the end of the rod's part inside, a boundary
+    /// of its depth profile as the rod's own ends are.
+    Mouth,
 }
 
 impl Extremum {
@@ -594,7 +598,7 @@ impl Extremum {
     /// law enters the level-set law (see [`line_extrema`]).
     pub fn weight(self) -> f64 {
         match self {
-            Self::End | Self::Maximum => 1.0,
+            Self::End | Self::Maximum | Self::Mouth => 1.0,
             Self::Minimum => -1.0,
         }
     }
@@ -623,11 +627,17 @@ impl Extremum {
 /// change of d(u·â)/ds at the samples (`RodInLumen::hidden_pair`), so a
 /// pair enters with equal depths, as the law needs for continuity. Only
 /// two such turns of u·â between one pair of samples go unseen.
+/// Where the rod passes an open end of the lumen, its part inside ends
+/// there: the section in the end plane is a maximum ([`Extremum::Mouth`])
+/// where the depth grows toward it, as the rod's own ends are, and the
+/// extrema are sought between it and the samples inside.
 /// `feature`: an end maximum is sample 0 or `samples` − 1, an interior
 /// maximum between samples k and k + 1 is k, an interior minimum there is
-/// `samples` + k, and the maximum of a pair born between samples 0 and 1
-/// beside an end maximum at sample 0 is 2·`samples` − 1: unique and
-/// stable, below 2·`samples`.
+/// `samples` + k, the maximum of a pair born between samples 0 and 1
+/// beside an end maximum at sample 0 is 2·`samples` − 1, and an open end's
+/// maximum is 2·`samples` where the rod leaves the lumen toward its +s end
+/// and 2·`samples` + 1 where it enters at its −s end: unique and stable,
+/// below 2·`samples` + 2.
 pub fn line_extrema<L: Centreline + ?Sized>(
     lumen: &L,
     rod: &Rod,
@@ -646,6 +656,73 @@ pub fn line_extrema<L: Centreline + ?Sized>(
 }
 
 impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
+    /// The extrema between axial positions `sa` < `sb` [m] (the axis
+    /// points `a`, `b` there), within the bracket of samples `k` and k + 1
+    /// of `n`: a maximum and minimum born together, and where u·â changes
+    /// sign, a maximum or a minimum; each put if deeper than `threshold`.
+    /// `beside_end`: an end maximum was put at sample 0 (the pair's feature
+    /// then moves to 2n − 1).
+    #[allow(clippy::too_many_arguments)]
+    fn bracket(
+        &self,
+        k: usize,
+        n: usize,
+        (sa, a): (f64, &Axis),
+        (sb, b): (f64, &Axis),
+        threshold: f64,
+        beside_end: bool,
+        put: &mut impl FnMut(Station, usize, Extremum),
+    ) {
+        if self.clear_between((sa, a), (sb, b), threshold) {
+            return;
+        }
+        if let Some((max, min)) = self.hidden_pair((sa, a), (sb, b)) {
+            let feature = if k == 0 && beside_end { 2 * n - 1 } else { k };
+            let mut pair = [
+                (max, feature, Extremum::Maximum),
+                (min, n + k, Extremum::Minimum),
+            ];
+            pair.sort_by(|p, q| p.0.total_cmp(&q.0));
+            for (x, feature, kind) in pair {
+                if let Some(st) = self.station(x) {
+                    put(st, feature, kind);
+                }
+            }
+        }
+        let found = match (a.growth > 0.0, b.growth > 0.0) {
+            (true, false) => self
+                .stationary((sa, a.growth), (sb, b.growth), 1.0)
+                .map(|x| (x, k, Extremum::Maximum)),
+            (false, true) => self
+                .stationary((sa, -a.growth), (sb, -b.growth), -1.0)
+                .map(|x| (x, n + k, Extremum::Minimum)),
+            _ => None,
+        };
+        if let Some((x, feature, kind)) = found
+            && let Some(st) = self.station(x)
+        {
+            put(st, feature, kind);
+        }
+    }
+
+    /// Where the rod passes an open end of the lumen between axial
+    /// positions `inside` (a station there) and `outside` (none) [m]: the
+    /// last position inside, to 1e-12 of the positions by bisection, and
+    /// its station. `None` if `inside` has no station after all.
+    fn mouth(&self, inside: f64, outside: f64) -> Option<(f64, Station)> {
+        let (mut lo, mut hi) = (inside, outside);
+        let mut station = self.station(lo)?;
+        let tolerance = 1e-12 * (1.0 + inside.abs().max(outside.abs()));
+        while (hi - lo).abs() > tolerance {
+            let mid = 0.5 * (lo + hi);
+            match self.station(mid) {
+                Some(st) => (lo, station) = (mid, st),
+                None => hi = mid,
+            }
+        }
+        Some((lo, station))
+    }
+
     /// [`line_extrema`] of this rod.
     fn extrema(&self, samples: u32, threshold: f64, emit: &mut impl FnMut(LocalContact, Extremum)) {
         let link = self;
@@ -673,41 +750,34 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             } else {
                 link.axis(s(k + 1))
             };
-            if let (Some(a), Some(b)) = (&here, &next)
-                && !link.clear_between((s(k), a), (s(k + 1), b), threshold)
-            {
-                if let Some((max, min)) = link.hidden_pair((s(k), a), (s(k + 1), b)) {
-                    let feature = if k == 0 && end_zero.is_some() {
-                        2 * n - 1
-                    } else {
-                        k
-                    };
-                    let mut pair = [
-                        (max, feature, Extremum::Maximum),
-                        (min, n + k, Extremum::Minimum),
-                    ];
-                    pair.sort_by(|p, q| p.0.total_cmp(&q.0));
-                    for (x, feature, kind) in pair {
-                        if let Some(st) = link.station(x) {
-                            put(st, feature, kind);
-                        }
+            // Where the rod leaves or enters the lumen between the samples,
+            // its part inside ends at the open end: a maximum there if it
+            // deepens toward it, and the extrema are sought up to it.
+            let (mut span, mut leaving) = (None, None);
+            match (here, next) {
+                (Some(a), Some(b)) => span = Some(((s(k), a), (s(k + 1), b))),
+                (Some(a), None) => {
+                    if let Some((x, st)) = link.mouth(s(k), s(k + 1)) {
+                        span = Some(((s(k), a), (x, st.axis)));
+                        leaving = Some(st).filter(|st| st.axis.growth > 0.0);
                     }
                 }
-                let rising = (a.growth > 0.0, b.growth > 0.0);
-                let found = match rising {
-                    (true, false) => link
-                        .stationary((s(k), a.growth), (s(k + 1), b.growth), 1.0)
-                        .map(|x| (x, k, Extremum::Maximum)),
-                    (false, true) => link
-                        .stationary((s(k), -a.growth), (s(k + 1), -b.growth), -1.0)
-                        .map(|x| (x, n + k, Extremum::Minimum)),
-                    _ => None,
-                };
-                if let Some((x, feature, kind)) = found
-                    && let Some(st) = link.station(x)
-                {
-                    put(st, feature, kind);
+                (None, Some(b)) => {
+                    if let Some((x, st)) = link.mouth(s(k + 1), s(k)) {
+                        if st.axis.growth <= 0.0 {
+                            put(st, 2 * n + 1, Extremum::Mouth);
+                        }
+                        span = Some(((x, st.axis), (s(k + 1), b)));
+                    }
                 }
+                (None, None) => {}
+            }
+            if let Some(((sa, a), (sb, b))) = span {
+                let beside_end = end_zero.is_some();
+                link.bracket(k, n, (sa, &a), (sb, &b), threshold, beside_end, &mut put);
+            }
+            if let Some(st) = leaving {
+                put(st, 2 * n, Extremum::Mouth);
             }
             here = next;
         }
@@ -830,6 +900,73 @@ mod tests {
                 assert!((df - dc).abs() < 1e-12, "{samples} samples: {df} vs {dc}");
             }
         }
+    }
+
+    #[test]
+    fn a_rod_through_an_open_end_of_the_tube_is_held_by_the_end_of_its_part_inside() {
+        // The straight tube of `straight` runs from x = −1 to x = +1 m. A
+        // flat-ended rod 15.1 mm below its axis, tilted by θ = 0.01 rad so that
+        // it sinks deeper toward one open end, slides out through that end.
+        // Every section deepens toward the end, so the one maximum of the
+        // depth over the part inside is the rod's end while it is inside, then
+        // the section in the end plane: at axial distance
+        // s* = min(h, (1 − |x_c|)/cos θ) from the centre, the section's
+        // deepest point (r below the axis across it) is
+        // δ = 15.1 mm + s*·sin θ + r·cos θ − R deep. Before the tube's ends
+        // were taken as boundaries, the rod found no contact at all once its
+        // end was out, 0.6 mm deep in the wall.
+        let (th, z, h, r, wall): (f64, f64, f64, f64, f64) = (0.01, 0.0151, 0.1, 0.043, 0.058);
+        let n = 9u32;
+        // Toward either end of the tube (x = ±1), the rod's axis pointing out
+        // (it leaves the tube at its +s end) or in (it enters at its −s end).
+        let cases = [
+            (1.0, 1.0, 2 * n),
+            (-1.0, 1.0, 2 * n),
+            (1.0, -1.0, 2 * n + 1),
+            (-1.0, -1.0, 2 * n + 1),
+        ];
+        for (dir, out, mouth_feature) in cases {
+            for step in 0..=40 {
+                // The centre from 0.85 to 0.95 m toward the end: the rod's end
+                // from 5 cm inside to 5 cm outside.
+                let xc = 0.85 + 0.0025 * f64::from(step);
+                let axis = out * Vector::new(dir * th.cos(), 0.0, -th.sin());
+                let rd = rod(Vector::new(dir * xc, 0.0, -z), axis);
+                let found = all_extrema(&straight(), &rd, n);
+                let s_star = h.min((1.0 - xc) / th.cos());
+                let expect = z + s_star * th.sin() + r * th.cos() - wall;
+                assert_eq!(found.len(), 1, "x_c = {xc}, {dir}: {found:?}");
+                let (depth, kind, feature) = found[0];
+                assert!(
+                    (depth - expect).abs() < 1e-12,
+                    "x_c = {xc}: {depth} vs {expect}"
+                );
+                if (1.0 - xc) / th.cos() < h - 1e-9 {
+                    assert_eq!(
+                        (kind, feature),
+                        (Extremum::Mouth, mouth_feature),
+                        "x_c = {xc}"
+                    );
+                } else {
+                    assert_eq!(kind, Extremum::End, "x_c = {xc}");
+                }
+                // The same maximum at any sampling (the samples only bracket).
+                for samples in [2, 5, 33] {
+                    let other = all_extrema(&straight(), &rd, samples);
+                    assert_eq!(other.len(), 1, "{samples} samples");
+                    assert!((other[0].0 - depth).abs() < 1e-12, "{samples} samples");
+                }
+            }
+        }
+    }
+
+    /// (depth, kind, feature) of every extremum, in axial order.
+    fn all_extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum, u32)> {
+        let mut out = vec![];
+        line_extrema(lumen, r, Ends::Flat, samples, 0.0, &mut |c, kind| {
+            out.push((c.depth, kind, c.feature))
+        });
+        out
     }
 
     /// A centreline that counts its nearest-point queries.

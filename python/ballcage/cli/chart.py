@@ -42,7 +42,7 @@ def add(commands: Commands) -> None:
     chart.add_argument("--joint-od", metavar="MM", help="outer diameter d of the joint [mm] (default 86, the paper's)")
     chart.add_argument(
         "--hinge", choices=("ball-keys", "ideal-cv"), default="ball-keys",
-        help="hinge model (default ball-keys, the paper's; ideal-cv is ~7x faster but has no keys and about half "
+        help="hinge model (default ball-keys, the paper's; ideal-cv is ~3.5x faster but has no keys and about half "
         "the tube force, docs/studies.md)",
     )
     chart.add_argument("--duration", metavar="S", help="simulated time per cell [s] (default 1.8)")

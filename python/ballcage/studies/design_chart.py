@@ -87,9 +87,10 @@ DEFAULT_LENGTHS: tuple[float, ...] = (0.15, 0.2, 0.3, 0.4, 0.5, 1.0)
 #: Simulated duration [s] of every cell (the paper's 1.8 s: three revolutions at 100 rpm).
 DEFAULT_DURATION = 1.8
 #: Wall seconds per simulated second of one case on one core of this project's 2-core AMD EPYC
-#: (2026-11-26, the adaptive default at rtol 1e-4, two cases at a time: the paper scene's sensitivity
-#: study, 7 s per 1.8 s run), for the estimate printed before a chart or a study runs.
-SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 4.0, "ideal-cv": 1.6}
+#: (2026-11-26, the adaptive default at rtol 1e-4, two cases at a time: the default chart's 20 cells,
+#: mean 3.6 s per 1.8 s cell, 38 s in all; ideal CV 11 s; docs/studies.md), for the estimate printed
+#: before a chart or a study runs.
+SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 2.1, "ideal-cv": 0.6}
 #: The quantities the chart table copies from the sweep's summary, in order.
 QUANTITY_COLUMNS: tuple[str, ...] = (
     "key_peak_n",

@@ -212,17 +212,18 @@ mod tests {
     use crate::geometry::PointSink;
     use std::sync::atomic::{AtomicUsize, Ordering};
 
-    /// Pair sizes as in the paper's scene: link–tube pairs of 18 slots
-    /// (level sets of 9 samples), and single-point pairs of which some latch
-    /// (Hunt–Crossley) and some do not (IMPACT).
+    /// Pair sizes as in the paper's scene: link–tube pairs of 20 slots
+    /// (level sets of 9 samples and the tube's two open ends), and
+    /// single-point pairs of which some latch (Hunt–Crossley) and some do
+    /// not (IMPACT).
     const PAIRS: [(usize, bool); 9] = [
-        (18, false),
-        (18, false),
+        (20, false),
+        (20, false),
         (1, true),
         (1, false),
         (1, true),
         (1, true),
-        (18, false),
+        (20, false),
         (1, false),
         (1, true),
     ];
@@ -244,7 +245,7 @@ mod tests {
         assert_eq!((table.points.len(), table.laws.len()), (slots, slots));
         assert_eq!((table.latched.len(), remembered), (4, 4));
         assert!(table.has_memory());
-        assert!(!ContactTable::sized([(18, false), (1, false)].into_iter()).has_memory());
+        assert!(!ContactTable::sized([(20, false), (1, false)].into_iter()).has_memory());
     }
 
     #[test]

@@ -124,10 +124,13 @@ fn turning(
         }
         // Otherwise through the axis point, (r − δ/2) beyond the midpoint
         // along n (for the patch law's centroid, the link's section there
-        // taken as a ball); an interior extremum slides along the axis.
+        // taken as a ball); an interior extremum slides along the axis. At
+        // the tube's open end the section point is held as a material point
+        // of the link: its sliding along the axis as the link crosses the
+        // end plane is left out of the Jacobian.
         _ => {
             let mut turning = field(c.point + (rod.radius - 0.5 * c.depth) * c.normal);
-            if kind.is_some() {
+            if kind.is_some_and(|k| k != Extremum::Mouth) {
                 turning.motion = CentreMotion::Slides(Slide {
                     direction: pt.1 * from_glam(rod.axis),
                     curvature: Vec3::zeros(),

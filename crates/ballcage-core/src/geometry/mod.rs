@@ -442,11 +442,12 @@ impl PairGeometry {
             | Self::CavitySphere { .. }
             | Self::RingCylinder(_) => 1,
             Self::CuboidHalfSpace => 8,
-            // Level sets: maxima at 0..n, interior minima at n..2n − 1.
+            // Level sets: maxima at 0..n, interior minima at n..2n − 1,
+            // the open ends of the tube at 2n and 2n + 1.
             Self::CylinderTube(LineContact {
                 points,
                 law: LineLaw::LevelSets,
-            }) => 2 * points as usize,
+            }) => 2 * points as usize + 2,
             Self::CylinderTube(LineContact { points, .. }) => points as usize,
         }
     }
