@@ -639,6 +639,7 @@ fn elastic_energy(pair: &ContactPair, points: &[ContactPoint]) -> f64 {
 /// latches onsets in [`Mode::Commit`], evaluates the laws and, with the
 /// slots' coupling, fills the pair's Jacobian blocks (stiffness weight
 /// `scale`).
+#[inline]
 fn evaluate_pair(
     model: &Model,
     (state, omega_world): (&State, &[Vec3]),

@@ -23,4 +23,12 @@ pub trait Centreline {
     fn nearest(&self, q: Vector) -> Option<CentrelinePoint>;
     /// Distance from the centreline to the wall [m].
     fn wall_radius(&self) -> f64;
+
+    /// How far `q` lies past the plane of the lumen's open end nearer it
+    /// [m], negative before it: a function linear along a straight line,
+    /// zero where [`Centreline::nearest`] stops finding a wall there. `None`
+    /// for a lumen without open ends.
+    fn past_end(&self, _q: Vector) -> Option<f64> {
+        None
+    }
 }

@@ -706,13 +706,78 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     }
 
     /// Where the rod passes an open end of the lumen between axial
-    /// positions `inside` (a station there) and `outside` (none) [m]: the
-    /// last position inside, to 1e-12 of the positions by bisection, and
-    /// its station. `None` if `inside` has no station after all.
-    fn mouth(&self, inside: f64, outside: f64) -> Option<(f64, Station)> {
-        let (mut lo, mut hi) = (inside, outside);
-        let mut station = self.station(lo)?;
+    /// positions `inside` (the axis point `at` there) and `outside` (no
+    /// station) [m]: the last position inside, to 1e-12 of the positions,
+    /// and its station; `None` if the rod's part between them cannot reach
+    /// `threshold` (the offset from the centreline grows by at most the
+    /// distance along the unit axis, as in [`Self::clear_between`]: leaving
+    /// that part out changes no contact reported).
+    ///
+    /// A station exists while the axis point and the section's deepest
+    /// point are both before the end plane: where [`Centreline::past_end`]
+    /// of the two, the larger, is ≤ 0. That is linear along the straight
+    /// axis where the axis point binds, nearly so where the section's point
+    /// does, so the Illinois variant of regula falsi finds it in a few
+    /// nearest-point queries, stopping within 1e-12 of the plane or of the
+    /// positions; by bisection where the lumen has no end plane.
+    fn mouth(
+        &self,
+        inside: f64,
+        outside: f64,
+        at: &Axis,
+        threshold: f64,
+    ) -> Option<(f64, Station)> {
+        // The part inside reaches at most as far as the axis point passes
+        // the end plane (linear along the axis, no query), or `outside`.
+        let plane = |s: f64| self.lumen.past_end(self.rod.at(s));
+        let length = match (plane(inside), plane(outside)) {
+            (Some(a), Some(b)) if a <= 0.0 && b > 0.0 => (outside - inside).abs() * (-a / (b - a)),
+            _ => (outside - inside).abs(),
+        };
+        let reach = at.offset + length * (1.0 + 1e-12) + self.rod.radius;
+        if self.cull && reach - self.lumen.wall_radius() < threshold - 1e-12 {
+            return None;
+        }
         let tolerance = 1e-12 * (1.0 + inside.abs().max(outside.abs()));
+        let (mut lo, mut hi) = (inside, outside);
+        if let (Some(mut glo), Some(mut ghi)) = (self.past_end(lo), self.past_end(hi))
+            && glo <= 0.0
+            && ghi > 0.0
+        {
+            // Which end moved last: +1 for lo, −1 for hi.
+            let mut side = 0;
+            for _ in 0..100 {
+                if (hi - lo).abs() <= tolerance {
+                    break;
+                }
+                let x = lo + (hi - lo) * (glo / (glo - ghi));
+                let between = (x - lo) * (hi - x) > 0.0;
+                let x = if between { x } else { 0.5 * (lo + hi) };
+                let Some(gx) = self.past_end(x) else { break };
+                if gx <= 0.0 {
+                    (lo, glo) = (x, gx);
+                    // Within round-off of the plane: the last station.
+                    if gx > -tolerance {
+                        break;
+                    }
+                    if side == 1 {
+                        ghi *= 0.5;
+                    }
+                    side = 1;
+                } else {
+                    (hi, ghi) = (x, gx);
+                    if side == -1 {
+                        glo *= 0.5;
+                    }
+                    side = -1;
+                }
+            }
+            if let Some(st) = self.station(lo) {
+                return Some((lo, st));
+            }
+            (lo, hi) = (inside, outside);
+        }
+        let mut station = self.station(lo)?;
         while (hi - lo).abs() > tolerance {
             let mid = 0.5 * (lo + hi);
             match self.station(mid) {
@@ -721,6 +786,28 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             }
         }
         Some((lo, station))
+    }
+
+    /// How far the station at axial position `s` [m] lies past the lumen's
+    /// end plane ([`Centreline::past_end`]): the axis point's distance where
+    /// it is past, else the larger of it and the section's deepest point's
+    /// (a flat rod's; a round rod's station is about the axis point alone).
+    fn past_end(&self, s: f64) -> Option<f64> {
+        let q = self.rod.at(s);
+        let axis = self.lumen.past_end(q)?;
+        if axis > 0.0 || self.ends == Ends::Round {
+            return Some(axis);
+        }
+        let Some((_, u, a)) = self.axis_at(s) else {
+            return Some(axis.max(f64::MIN_POSITIVE));
+        };
+        let across = u - a.growth * self.rod.axis;
+        let len = across.length();
+        if len < 1e-15 {
+            return Some(axis);
+        }
+        let w = q + self.rod.radius * across / len;
+        Some(axis.max(self.lumen.past_end(w)?))
     }
 
     /// [`line_extrema`] of this rod.
@@ -757,13 +844,13 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             match (here, next) {
                 (Some(a), Some(b)) => span = Some(((s(k), a), (s(k + 1), b))),
                 (Some(a), None) => {
-                    if let Some((x, st)) = link.mouth(s(k), s(k + 1)) {
+                    if let Some((x, st)) = link.mouth(s(k), s(k + 1), &a, threshold) {
                         span = Some(((s(k), a), (x, st.axis)));
                         leaving = Some(st).filter(|st| st.axis.growth > 0.0);
                     }
                 }
                 (None, Some(b)) => {
-                    if let Some((x, st)) = link.mouth(s(k + 1), s(k)) {
+                    if let Some((x, st)) = link.mouth(s(k + 1), s(k), &b, threshold) {
                         if st.axis.growth <= 0.0 {
                             put(st, 2 * n + 1, Extremum::Mouth);
                         }

@@ -279,6 +279,18 @@ impl Centreline for TubeInterior {
     fn wall_radius(&self) -> f64 {
         self.inner_radius
     }
+
+    /// Past the start plane, (start − q)·t̂₀; past the end plane,
+    /// (q − end)·t̂₁; of the two, the plane whose end point is nearer `q`.
+    fn past_end(&self, q: Vector) -> Option<f64> {
+        Some(
+            if (q - self.start).length_squared() < (q - self.end).length_squared() {
+                (self.start - q).dot(self.start_dir)
+            } else {
+                (q - self.end).dot(self.end_dir)
+            },
+        )
+    }
 }
 
 /// The bounding box of one centreline segment: its end points and, for an
