@@ -161,10 +161,14 @@ pub struct SlotSink<'a> {
 impl PointSink for SlotSink<'_> {
     #[inline]
     fn push(&mut self, point: ContactPoint) {
-        // A query reports at most `PairGeometry::slots` points: a pair that
-        // reported more would be a geometry bug, caught here.
-        self.slots[self.len] = point;
-        self.len += 1;
+        // Every query reports at most `PairGeometry::slots` points, each in
+        // a slot of its own (a straight link crosses each of the tube's end
+        // planes once). Were one to report more, the extra points would be
+        // dropped rather than the run stopped by a panic.
+        if let Some(slot) = self.slots.get_mut(self.len) {
+            *slot = point;
+            self.len += 1;
+        }
     }
 
     fn clear(&mut self) {
@@ -746,6 +750,27 @@ fn cavity_sphere(
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn a_full_slot_sink_drops_further_points_instead_of_panicking() {
+        let mut slots = [ContactPoint::UNUSED; 2];
+        let mut sink = SlotSink {
+            slots: &mut slots,
+            len: 0,
+        };
+        for depth in [1.0, 2.0, 3.0] {
+            let mut p = ContactPoint::UNUSED;
+            p.depth = depth;
+            sink.push(p);
+        }
+        assert_eq!(sink.len, 2);
+        assert_eq!(
+            sink.filled().iter().map(|p| p.depth).collect::<Vec<_>>(),
+            [1.0, 2.0]
+        );
+        sink.clear();
+        assert!(sink.filled().is_empty());
+    }
 
     const LINE: LineContact = LineContact {
         points: 5,
