@@ -3,6 +3,7 @@
 mod common;
 
 use ballcage_core::force::joint::twist_angle;
+use ballcage_core::math::Vec3;
 use ballcage_core::record::ColumnData;
 use ballcage_core::{Document, Simulation};
 
@@ -1129,4 +1130,68 @@ fn the_load_places_the_chain_on_the_one_centreline_its_layout_keeps() {
         let link = bodies[layout.chain[k]].position;
         assert_eq!(link, [centre.x, centre.y, centre.z], "link {k}");
     }
+}
+
+#[test]
+fn links_too_long_for_the_centreline_are_placed_outside_it_clear_of_the_inner_wall() {
+    // A 0.5 m link of Ø86 mm in a Ø106 mm tube bent to R = 2 m: eq. (9)
+    // allows 0.57 m, but its chord between two hinges on the centreline has
+    // a sagitta of R − √(R² − 0.25²) = 15.69 mm and cuts 15.69 + 43 − 53 =
+    // 5.69 mm into the inner wall (the design chart's cell with
+    // `--tube-id 106` started there and stopped at t = 0). Placed on the arc
+    // of radius R + δ, δ = 5.69 mm, every link clears the inner wall and
+    // stays within the outer one.
+    let over = |d: f64| {
+        [
+            "borehole.curvature_radius=2.0".to_string(),
+            "pipe.pitch=0.5".to_string(),
+            format!("borehole.inner_diameter={d}"),
+        ]
+    };
+    let doc = Document::from_toml_str("kind = \"drill-pipe\"\n", &over(0.106)).unwrap();
+    let (spec, _) = doc.drill_pipe_parts().unwrap();
+    let sagitta = 2.0 - (4.0f64 - 0.25 * 0.25).sqrt();
+    let delta = sagitta + 0.043 - 0.053;
+    assert!(
+        (spec.placement_offset() - delta).abs() < 1e-15,
+        "{}",
+        spec.placement_offset()
+    );
+    assert!((delta - 5.69e-3).abs() < 1e-5);
+    let (hinges, _) = spec.placed_chain();
+    // The bend's centre: the arc starts at the origin downward and bends toward +x.
+    let centre = Vec3::new(2.0, 0.0, 0.0);
+    let (inner, outer) = (2.0 - 0.053, 2.0 + 0.053);
+    let arc_end = spec.borehole.build_angle_deg.to_radians();
+    let mut on_arc = 0;
+    for k in 1..=spec.pipe.joints {
+        let (a, b) = (hinges[k - 1] - centre, hinges[k] - centre);
+        // Links wholly on the arc (both hinges at angles within it).
+        let angle = |p: Vec3| (-p.z).atan2(-p.x);
+        if angle(a) > arc_end || angle(b) > arc_end {
+            continue;
+        }
+        on_arc += 1;
+        let middle = (0.5 * (a + b)).norm();
+        assert!(
+            middle - 0.043 >= inner - 1e-12,
+            "link {k} cuts {} m into the inner wall",
+            inner - (middle - 0.043)
+        );
+        assert!(
+            a.norm() + 0.043 <= outer + 1e-4,
+            "link {k}'s end reaches {} m",
+            a.norm() + 0.043
+        );
+    }
+    assert!(on_arc >= 5, "{on_arc} links on the quarter arc of π m");
+    // The paper's tube (Ø116 mm) with its 0.2 m links needs no offset: the
+    // chord cuts nothing, and the chain sits on the centreline as before.
+    let paper = Document::from_toml_str("kind = \"drill-pipe\"\n", &[]).unwrap();
+    let (spec, _) = paper.drill_pipe_parts().unwrap();
+    assert_eq!(spec.placement_offset(), 0.0);
+    assert!(
+        (spec.hinge_positions()[0]).norm() == 0.0,
+        "hinge 0 at the arc's start"
+    );
 }

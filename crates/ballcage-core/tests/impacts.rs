@@ -13,32 +13,16 @@ use ballcage_core::force::{DissipativeLaw, effective_restitution, restitution_ch
 /// [m], peak normal force [N]).
 fn impact(law: &str, m: f64, v: f64, dt: f64, duration: f64) -> (f64, f64, f64, f64) {
     let r = 0.0075;
-    let toml = format!(
-        r#"
-        [simulation]
-        duration = {duration}
-        dt = {dt}
-        output_interval = {dt}
-        integrator = "rk4"
-        [record]
-        tables = []
-        [[bodies]]
-        name = "ground"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = {r} }}
-        mass = {m}
-        position = [0.0, 0.0, {r}]
-        velocity = [0.0, 0.0, {neg_v}]
-        [[contacts]]
-        bodies = ["ground", "ball"]
-        normal = {law}
-        "#,
-        neg_v = -v
+    let mut sim = common::ball_on_floor(
+        &format!("duration = {duration}\ndt = {dt}\noutput_interval = {dt}\nintegrator = \"rk4\""),
+        0.0,
+        &format!(
+            "shape = {{ type = \"ball\", radius = {r} }}\nmass = {m}\n\
+             position = [0.0, 0.0, {r}]\nvelocity = [0.0, 0.0, {neg_v}]",
+            neg_v = -v
+        ),
+        &format!("normal = {law}"),
     );
-    let mut sim = common::sim(&toml);
     let i = common::body(&sim, "ball");
     let (mut t_end, mut peak, mut force) = (f64::NAN, 0.0_f64, 0.0_f64);
     let mut prev = (0.0, r);

@@ -293,39 +293,27 @@ fn without_velocity_dependent_forces_it_is_symplectic_euler() {
 /// `g` (gravity scaled to stand for the squeeze of the races), starting
 /// `d0` deep at rest.
 fn loaded_ball(integrator: &str, g: f64, d0: f64, duration: f64) -> Simulation {
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = {duration}
-        dt = 1e-5
-        output_interval = 1e-3
-        integrator = "{integrator}"
-        [world]
-        gravity = [0.0, 0.0, {neg_g}]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "key"
-        shape = {{ type = "ball", radius = 0.0075 }}
-        mass = 0.014
-        position = [0.0, 0.0, {z0}]
-        [[contacts]]
-        bodies = ["floor", "key"]
-        normal = {{ law = "impact", stiffness = 1e5, exponent = 2.2, damping = 10.0, depth_max = 0.1, units = "N-mm-s" }}
-        "#,
-        neg_g = -g,
-        z0 = 0.0075 - d0,
-    ))
+    common::ball_on_floor(
+        &format!(
+            "duration = {duration}\ndt = 1e-5\noutput_interval = 1e-3\nintegrator = \"{integrator}\""
+        ),
+        g,
+        &format!(
+            "shape = {{ type = \"ball\", radius = 0.0075 }}\nmass = 0.014\nposition = [0.0, 0.0, {z0}]",
+            z0 = 0.0075 - d0
+        ),
+        PAPER_IMPACT,
+    )
 }
+
+/// The paper's IMPACT law for the ball keys, as a contact's `normal` key.
+const PAPER_IMPACT: &str = "normal = { law = \"impact\", stiffness = 1e5, exponent = 2.2, \
+     damping = 10.0, depth_max = 0.1, units = \"N-mm-s\" }";
 
 /// Runs to the end (or the first error); returns the result, the final
 /// depth [m] and the largest speed seen at 1 ms samples [m/s].
 fn run_ball(sim: &mut Simulation) -> (Result<(), ballcage_core::SimulationError>, f64, f64) {
-    let i = common::body(sim, "key");
+    let i = common::body(sim, "ball");
     let mut vmax = 0.0_f64;
     while !sim.is_done() {
         let r = sim.advance_to(sim.time() + 1e-3);

@@ -171,34 +171,17 @@ fn sdirk2_rotations_are_second_order_on_the_manifold() {
 /// The 14 g ball key of implicit.rs loaded by 6 kN (gravity scaled), with
 /// the paper's IMPACT law or without damping.
 fn loaded_key(dt: f64, damping: f64, extra: &str) -> Simulation {
-    let g = 6000.0 / 0.014;
-    common::sim(&format!(
-        r#"
-        [simulation]
-        duration = 0.05
-        dt = {dt}
-        output_interval = 1e-3
-        integrator = "sdirk2"
-        {extra}
-        [world]
-        gravity = [0.0, 0.0, {neg_g}]
-        [record]
-        tables = []
-        [[bodies]]
-        name = "floor"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "key"
-        shape = {{ type = "ball", radius = 0.0075 }}
-        mass = 0.014
-        position = [0.0, 0.0, 0.0075]
-        [[contacts]]
-        bodies = ["floor", "key"]
-        normal = {{ law = "impact", stiffness = 1e5, exponent = 2.2, damping = {damping}, depth_max = 0.1, units = "N-mm-s" }}
-        "#,
-        neg_g = -g,
-    ))
+    common::ball_on_floor(
+        &format!(
+            "duration = 0.05\ndt = {dt}\noutput_interval = 1e-3\nintegrator = \"sdirk2\"\n{extra}"
+        ),
+        6000.0 / 0.014,
+        "shape = { type = \"ball\", radius = 0.0075 }\nmass = 0.014\nposition = [0.0, 0.0, 0.0075]",
+        &format!(
+            "normal = {{ law = \"impact\", stiffness = 1e5, exponent = 2.2, damping = {damping}, \
+             depth_max = 0.1, units = \"N-mm-s\" }}"
+        ),
+    )
 }
 
 #[test]
@@ -212,7 +195,7 @@ fn stiff_contact_settles_at_a_hundred_times_the_explicit_step() {
     for damping in [10.0, 0.0] {
         let mut sim = loaded_key(1e-4, damping, "");
         sim.run().unwrap();
-        let i = common::body(&sim, "key");
+        let i = common::body(&sim, "ball");
         let depth = 0.0075 - sim.state().pos[i].z;
         assert!(
             ((depth - expect) / expect).abs() < 1e-3,
@@ -244,7 +227,7 @@ fn the_jacobian_is_reused_while_newton_converges_fast() {
     // halved the last increment instead.
     assert!(a.solves <= a.newton_iterations);
     assert_eq!(reused.force_evaluations(), a.newton_iterations);
-    let i = common::body(&reused, "key");
+    let i = common::body(&reused, "ball");
     let dz = reused.state().pos[i].z - fresh.state().pos[i].z;
     assert!(dz.abs() < 1e-9, "reuse changed the answer by {dz:e} m");
 }
@@ -286,7 +269,7 @@ fn newton_that_cannot_converge_falls_back_to_linearly_implicit_euler_at_h_over_1
     assert_eq!(sim.steps(), 500);
     assert!(stats.fallbacks > 500, "{stats:?}");
     assert!(16 * stats.halvings >= 15 * stats.fallbacks, "{stats:?}");
-    let i = common::body(&sim, "key");
+    let i = common::body(&sim, "ball");
     let depth = 0.0075 - sim.state().pos[i].z;
     let hand = (6000.0f64 / 1e5).powf(1.0 / 2.2) * 1e-3;
     assert!((depth - hand).abs() < 1e-3 * hand, "{depth} m vs {hand} m");

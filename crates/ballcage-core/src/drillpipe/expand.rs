@@ -83,9 +83,51 @@ impl DrillPipeSpec {
         self.hinges_on(&self.extended_centreline())
     }
 
-    /// Hinge centres placed on `centreline`, the [`Self::extended_centreline`] [m].
+    /// Hinge centres [m] for the chain in the tube whose extended centreline
+    /// is `centreline`: on it, or where a link's chord on it would cut into
+    /// the bend's inner wall, on the path [`Self::placement_offset`] outside
+    /// it.
     fn hinges_on(&self, centreline: &TubePath) -> Vec<Vec3> {
-        chain::place_hinges(centreline, self.pipe.pitch, self.pipe.joints + 1)
+        let offset = self.placement_offset();
+        let count = self.pipe.joints + 1;
+        if offset == 0.0 {
+            return chain::place_hinges(centreline, self.pipe.pitch, count);
+        }
+        let b = &self.borehole;
+        let extension = 2.0 * self.pipe.joints as f64 * self.pipe.pitch;
+        let outward = -Vec3::from(TUBE_BEND);
+        let path = TubePath::new(
+            b.inner_diameter / 2.0,
+            offset * outward,
+            TUBE_DIRECTION,
+            &[
+                TubeSegment::Arc {
+                    radius: b.curvature_radius + offset,
+                    angle: b.build_angle_deg.to_radians(),
+                    bend: Vec3::from(TUBE_BEND),
+                },
+                TubeSegment::Straight { length: extension },
+            ],
+        );
+        chain::place_hinges(&path, self.pipe.pitch, count)
+    }
+
+    /// How far outside the tube's centreline the hinges are placed [m]
+    /// (docs/model.md §4): by how much a link's chord between two hinges on
+    /// the centreline arc would cut into the bend's inner wall, its sagitta
+    /// R − √(R² − (L/2)²) plus the link's radius r beyond the tube's
+    /// D/2; 0 where it clears it, as in the paper's scene. Placed on the
+    /// concentric arc of radius R + δ, the chord's middle clears the inner
+    /// wall and its ends stay within the wall while δ ≤ (D − d)/2, which
+    /// eq. (9) ensures to first order.
+    pub fn placement_offset(&self) -> f64 {
+        let (b, p) = (&self.borehole, &self.pipe);
+        let (radius, half) = (b.curvature_radius, p.pitch / 2.0);
+        if half >= radius {
+            return 0.0;
+        }
+        let sagitta = radius - (radius * radius - half * half).sqrt();
+        (sagitta + p.link_diameter / 2.0 - b.inner_diameter / 2.0).max(0.0)
     }
 
     /// The chain as placed at t = 0: hinge centres 0…n [m] and unit body
