@@ -11,12 +11,12 @@
 use crate::force::friction_force;
 use crate::force::joint::twist_axis;
 use crate::geometry::{CentreMotion, ContactPoint, PointSink, Rim, Slide};
-
-mod table;
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
 use nalgebra::Vector6;
 use table::{ContactTable, PairSlots};
+
+mod table;
 
 /// Accelerations of every body (zero for bodies that are not integrated).
 #[derive(Debug, Clone, PartialEq)]
