@@ -486,7 +486,8 @@ impl Dynamics {
     /// friction it carries), the joint springs, and the geometric terms of
     /// the normal forces and the joint springs: normals turning across the
     /// curved surfaces and with the bodies, lever arms turning with the
-    /// bodies, contact points sliding along a link, a ring or a rim
+    /// bodies, contact points sliding along a link, a ring or a rim, or
+    /// with a link's section across a tube's end plane
     /// ([`crate::geometry::NormalTurning`]). Left out: the friction force's
     /// turning, the damping and slip's dependence on the pose (both vanish
     /// at rest) and the twist spring's axis turning (tests/jacobian.rs:
@@ -888,7 +889,8 @@ impl CouplingJacobian {
     /// δτ_P = [F_P]×[r_P]×·δθ_P and δτ_Q = [F_P]×·(δx_P − [r_P]×·δθ_P − δx_Q).
     /// The friction force's turning is left out (it is μ times smaller and
     /// vanishes at rest). `k` = s·∂F_n/∂δ, for a centre that moves on its
-    /// body into or out of the wall ([`CentreMotion::Rim`]).
+    /// body into or out of the wall ([`CentreMotion::Rim`],
+    /// [`CentreMotion::Crosses`]).
     fn add_turning(
         &mut self,
         state: &State,
@@ -928,7 +930,7 @@ impl CouplingJacobian {
             CentreMotion::Slides(slide) => {
                 add_slide(blocks, slide, &t.curvature, &n, f, (&rp, &rq));
             }
-            CentreMotion::Rim(rim) => {
+            CentreMotion::Rim(_) | CentreMotion::Crosses(_) => {
                 // ∂F_P/∂(c's own motion): the normal turning, and the depth
                 // with the friction it carries.
                 let along = if e.normal_force != 0.0 {
@@ -938,14 +940,16 @@ impl CouplingJacobian {
                 };
                 let g = f * t.curvature - k * along * n.transpose();
                 let (xp, xq) = (state.pos[p], state.pos[q]);
-                add_rim(
-                    blocks,
-                    rim,
-                    &g,
-                    &(f * n),
-                    (&rp, &rq),
-                    (&(rim.end - xp), &(rim.end - xq)),
-                );
+                let moves = match &t.motion {
+                    CentreMotion::Rim(rim) => {
+                        rim_motion(rim, (&(rim.end - xp), &(rim.end - xq))).map(|m| m.0)
+                    }
+                    CentreMotion::Crosses(cr) => crossing_motion(cr, &t.centre, (&xp, &xq)),
+                    _ => None,
+                };
+                if let Some(moves) = moves {
+                    add_centre_motion(blocks, moves, &g, &(f * n), (&rp, &rq));
+                }
             }
         }
         self.active = true;
@@ -1147,32 +1151,27 @@ fn add_slide(
     *qq += w_q * row_q.transpose();
 }
 
-/// Adds to the blocks [PP, PQ, QP, QQ] of [`CouplingJacobian::add_turning`]
-/// the motion of a rim point around its rim ([`Rim`]): c moves on P by
-/// e = M_P·δq_P + M_Q·δq_Q, and the wrenches change by W_P·e (on P) and
-/// W_Q·e (on Q), with `g` = ∂F_P/∂e (the normal turning and the depth),
-/// `fp` the scaled force on P, `arms` (c − x_P, c − x_Q) and `ends`
-/// (q − x_P, q − x_Q).
-fn add_rim(
-    blocks: [&mut Mat6; 4],
-    rim: &Rim,
-    g: &Mat3,
-    fp: &Vec3,
-    (rp, rq): (&Vec3, &Vec3),
-    (qp, qq): (&Vec3, &Vec3),
-) {
+/// ∂e/∂(δx, δθ) of bodies P and Q, e the motion of a contact's centre on
+/// P beyond moving with P.
+type CentreMoves = (nalgebra::Matrix3x6<f64>, nalgebra::Matrix3x6<f64>);
+
+/// The motion of a rim point around its rim ([`Rim`]), with `ends` the arms
+/// (q − x_P, q − x_Q) of the end's axis point q, and the rim point's rate
+/// along the rod's axis as its section moves along it, â + ∂(r·d)/∂s;
+/// `None` where the end's axis lies on the lumen's core (no definite rim
+/// point).
+fn rim_motion(rim: &Rim, (qp, qq): (&Vec3, &Vec3)) -> Option<(CentreMoves, Vec3)> {
     let (a, u) = (rim.axis, rim.offset);
     let pi = Mat3::identity() - a * a.transpose();
     let across = pi * u;
     let len = across.norm();
     if len <= 1e-15 {
-        return;
+        return None;
     }
     let d = across / len;
     let turn = (rim.radius / len) * (Mat3::identity() - d * d.transpose());
     let pa = pi * (Mat3::identity() - rim.beta * rim.core_tangent * rim.core_tangent.transpose());
     let grow = u.dot(&a);
-    // ∂e/∂(δx, δθ) of P and of Q.
     let mut mp = nalgebra::Matrix3x6::zeros();
     mp.fixed_view_mut::<3, 3>(0, 0).copy_from(&(turn * pa));
     let rot_p = -(pa * qp.cross_matrix()) + grow * a.cross_matrix() - a * a.cross(&u).transpose();
@@ -1182,6 +1181,61 @@ fn add_rim(
     mq.fixed_view_mut::<3, 3>(0, 0).copy_from(&(-(turn * pa)));
     let rot_q = pa * qq.cross_matrix() - pi * u.cross_matrix();
     mq.fixed_view_mut::<3, 3>(0, 3).copy_from(&(turn * rot_q));
+    Some(((mp, mq), a + turn * pa * a))
+}
+
+/// The motion of the deepest point c of a section in an open end's plane
+/// ([`crate::geometry::Crossing`]): around the section as a rim point,
+/// e_rim = M_P·δq_P + M_Q·δq_Q, and with the section along the axis,
+/// v·δs, v = â + ∂(r·d)/∂s. The point p on the plane (the axis point q, or
+/// c) stays on it: t̂·(δp_P − δp_Q) + t̂·ṗ·δs = 0, with δp_i the motion of
+/// p as a point of body i (plus e_rim for c) and ṗ its rate along the axis
+/// (â for q, v for c). `centre` is c, `bodies` (x_P, x_Q); `None` where the
+/// section has no definite rim point or its axis lies in the plane.
+fn crossing_motion(
+    cr: &crate::geometry::Crossing,
+    centre: &Vec3,
+    (xp, xq): (&Vec3, &Vec3),
+) -> Option<CentreMoves> {
+    let q = cr.rim.end;
+    let ((mut mp, mut mq), v) = rim_motion(&cr.rim, (&(q - xp), &(q - xq)))?;
+    let t = cr.plane_normal;
+    let (p, rate) = if cr.rim_on_plane {
+        (*centre, v)
+    } else {
+        (q, cr.rim.axis)
+    };
+    let den = t.dot(&rate);
+    if den.abs() <= 1e-12 {
+        return None;
+    }
+    let material = |x: &Vec3| {
+        let th = (p - x).cross(&t);
+        nalgebra::RowVector6::new(t.x, t.y, t.z, th.x, th.y, th.z)
+    };
+    let (mut row_p, mut row_q) = (material(xp), -material(xq));
+    if cr.rim_on_plane {
+        row_p += t.transpose() * mp;
+        row_q += t.transpose() * mq;
+    }
+    mp -= v * (row_p / den);
+    mq -= v * (row_q / den);
+    Some((mp, mq))
+}
+
+/// Adds to the blocks [PP, PQ, QP, QQ] of [`CouplingJacobian::add_turning`]
+/// the motion e = M_P·δq_P + M_Q·δq_Q (`moves`) of a contact's centre on P
+/// beyond moving with P (a rim point around its rim, a section sliding to
+/// stay in a plane): the wrenches change by W_P·e (on P) and W_Q·e (on Q),
+/// with `g` = ∂F_P/∂e (the normal turning and the depth), `fp` the scaled
+/// force on P and `arms` (c − x_P, c − x_Q).
+fn add_centre_motion(
+    blocks: [&mut Mat6; 4],
+    (mp, mq): CentreMoves,
+    g: &Mat3,
+    fp: &Vec3,
+    (rp, rq): (&Vec3, &Vec3),
+) {
     let fx = fp.cross_matrix();
     let wrench = |r: &Vec3, sign: f64| {
         let mut w = nalgebra::Matrix6x3::zeros();

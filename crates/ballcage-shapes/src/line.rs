@@ -740,10 +740,12 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         }
         let tolerance = 1e-12 * (1.0 + inside.abs().max(outside.abs()));
         let (mut lo, mut hi) = (inside, outside);
-        if let (Some(mut glo), Some(mut ghi)) = (self.past_end(lo), self.past_end(hi))
-            && glo <= 0.0
-            && ghi > 0.0
-        {
+        if let (Some(mut glo), Some(mut ghi)) = (self.past_end(lo), self.past_end(hi)) {
+            // A station missing before the plane (the rod's end on the
+            // centreline, where no deepest point is defined) is no open end.
+            if !(glo <= 0.0 && ghi > 0.0) {
+                return None;
+            }
             // Which end moved last: +1 for lo, −1 for hi.
             let mut side = 0;
             for _ in 0..100 {

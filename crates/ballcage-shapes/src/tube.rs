@@ -139,6 +139,16 @@ impl TubeInterior {
         [(self.start, -self.start_dir), (self.end, self.end_dir)]
     }
 
+    /// The open end of [`Self::ends`] whose point is nearer `q`.
+    pub fn nearer_end(&self, q: Vector) -> (Vector, Vector) {
+        let [start, end] = self.ends();
+        if (q - start.0).length_squared() < (q - end.0).length_squared() {
+            start
+        } else {
+            end
+        }
+    }
+
     /// Centreline point at arc length `s` [m] from the start (clamped), with its tangent.
     pub fn point_at(&self, s: f64) -> CentrelinePoint {
         let mut rest = s.clamp(0.0, self.length);
@@ -280,16 +290,11 @@ impl Centreline for TubeInterior {
         self.inner_radius
     }
 
-    /// Past the start plane, (start − q)·t̂₀; past the end plane,
-    /// (q − end)·t̂₁; of the two, the plane whose end point is nearer `q`.
+    /// (q − e)·ô for the open end (e, ô) of [`TubeInterior::ends`] whose
+    /// point e is nearer `q`.
     fn past_end(&self, q: Vector) -> Option<f64> {
-        Some(
-            if (q - self.start).length_squared() < (q - self.end).length_squared() {
-                (self.start - q).dot(self.start_dir)
-            } else {
-                (q - self.end).dot(self.end_dir)
-            },
-        )
+        let (e, out) = self.nearer_end(q);
+        Some((q - e).dot(out))
     }
 }
 

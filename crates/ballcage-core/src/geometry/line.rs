@@ -30,8 +30,8 @@ use ballcage_shapes::{Rod, TubeInterior};
 use parry3d_f64::math::Vector;
 
 use super::{
-    CentreMotion, ContactPoint, LineContact, LineLaw, NormalTurning, PointSink, Rim, Slide,
-    TubePath,
+    CentreMotion, ContactPoint, Crossing, LineContact, LineLaw, NormalTurning, PointSink, Rim,
+    Slide, TubePath,
 };
 use crate::math::{Quat, Vec3, from_glam, to_glam};
 use ballcage_shapes::line::Extremum;
@@ -122,15 +122,32 @@ fn turning(
             turning.motion = rim(rod, s, inside, pt);
             turning
         }
+        // The section in an open end's plane: like a rim, through its
+        // deepest point w, which moves around the section and, with the
+        // section, along the axis to keep the section on the plane.
+        Some(Extremum::Mouth) => {
+            let deepest = c.point - 0.5 * c.depth * c.normal;
+            let mut turning = field(deepest);
+            // w − q is across the axis: the section's axial position.
+            let s = (deepest - rod.centre).dot(rod.axis);
+            let q = rod.at(s);
+            let (end, out) = inside.nearer_end(q);
+            turning.motion = match rim(rod, s, inside, pt) {
+                CentreMotion::Rim(section) => CentreMotion::Crosses(Crossing {
+                    rim: section,
+                    plane_normal: pt.1 * from_glam(out),
+                    rim_on_plane: (deepest - end).dot(out) > (q - end).dot(out),
+                }),
+                other => other,
+            };
+            turning
+        }
         // Otherwise through the axis point, (r − δ/2) beyond the midpoint
         // along n (for the patch law's centroid, the link's section there
-        // taken as a ball); an interior extremum slides along the axis. At
-        // the tube's open end the section point is held as a material point
-        // of the link: its sliding along the axis as the link crosses the
-        // end plane is left out of the Jacobian.
+        // taken as a ball); an interior extremum slides along the axis.
         _ => {
             let mut turning = field(c.point + (rod.radius - 0.5 * c.depth) * c.normal);
-            if kind.is_some_and(|k| k != Extremum::Mouth) {
+            if kind.is_some() {
                 turning.motion = CentreMotion::Slides(Slide {
                     direction: pt.1 * from_glam(rod.axis),
                     curvature: Vec3::zeros(),

@@ -235,6 +235,8 @@ pub enum CentreMotion {
     Slides(Slide),
     /// c is a flat rod end's rim point in a lumen.
     Rim(Rim),
+    /// c is the axis point of the rod's section in an open end's plane.
+    Crosses(Crossing),
 }
 
 /// A flat rod end's rim point in a lumen (`ballcage_shapes::line`): with q
@@ -257,6 +259,24 @@ pub struct Rim {
     pub core_tangent: Vec3,
     /// β = 1/(1 − u·κ) at P(q), κ the core's curvature vector.
     pub beta: f64,
+}
+
+/// The section of a flat rod in the plane of a lumen's open end (the last
+/// one with a wall, `ballcage_shapes::line`): its deepest point c is a rim
+/// point of that section ([`Rim`], `rim.end` the section's axis point q),
+/// and the section slides along the rod's axis â so that its point p on the
+/// plane (q, or c where c reaches the plane first) stays on it. With t̂ the
+/// plane's normal, carried by the lumen's body, the slide δs follows from
+/// t̂·δp = 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Crossing {
+    /// The section as a rim.
+    pub rim: Rim,
+    /// The plane's unit normal t̂, world frame.
+    pub plane_normal: Vec3,
+    /// Whether the deepest point c, not the axis point q, is the one on the
+    /// plane.
+    pub rim_on_plane: bool,
 }
 
 /// The curve on its body along which a contact's centre c slides: c stays
