@@ -90,6 +90,12 @@ class Scene:
     def from_dict(obj: dict[str, Any], overrides: Sequence[str] = ...) -> Scene:
         """Same as `from_toml` for a dict of the same structure. Raises `SceneError`."""
 
+    def engine_digest(self) -> str:
+        """A digest (hex) of everything a run of the scene computes from (its expansion, time stepping, recording,
+        start and each pair's Hertz and wear model): two scenes with the same digest record bitwise the same tables,
+        so a sweep runs them once; what they differ in enters only what is computed from the tables afterwards
+        (``fatigue.*``) or nothing the scene builds (``pipe.ideal_cv.*`` with ball-key hinges)."""
+
     def to_toml(self, *, units: bool = False) -> str:
         """The resolved scene as TOML, with every default written out.
 

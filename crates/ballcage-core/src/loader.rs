@@ -350,6 +350,28 @@ impl Document {
         }
     }
 
+    /// A digest of everything a run of the document computes from: the
+    /// generic scene the engine runs (for a drill pipe, its expansion, with
+    /// the time stepping, recording and divergence checks), the state at
+    /// t = 0 and the set-up of the document's own tables (each pair's Hertz
+    /// and wear model). The engine is deterministic, so two documents with
+    /// the same digest record bitwise the same tables: whatever they differ
+    /// in enters only what is computed from those tables afterwards (the
+    /// fatigue outputs, `fatigue.*`), or nothing this scene builds
+    /// (`pipe.ideal_cv.*` with ball-key hinges). Sweeps run such documents
+    /// once. A hex string, stable within one build of ballcage.
+    pub fn engine_digest(&self) -> String {
+        use std::hash::{Hash, Hasher};
+        let mut hasher = std::collections::hash_map::DefaultHasher::new();
+        format!("{:?}", self.scene).hash(&mut hasher);
+        format!("{:?}", self.state).hash(&mut hasher);
+        if let Source::DrillPipe { spec, layout } = &self.source {
+            let tables = PipeTables::new(spec, layout.as_ref().clone(), &self.model, &self.state);
+            format!("{tables:?}").hash(&mut hasher);
+        }
+        format!("{:016x}", hasher.finish())
+    }
+
     /// The estimated size of every table a run of the document records (at
     /// most; checked against `record.max_bytes` when the document was made).
     pub fn memory_estimate(&self) -> Vec<crate::record::TableEstimate> {

@@ -247,6 +247,13 @@ impl Scene {
         }
     }
 
+    /// A digest (hex) of everything a run of the scene computes from: two
+    /// scenes with the same digest record bitwise the same tables, so a
+    /// sweep runs them once (`Document::engine_digest`).
+    fn engine_digest(&self) -> String {
+        self.inner.engine_digest()
+    }
+
     /// Scene name.
     #[getter]
     fn name(&self) -> String {

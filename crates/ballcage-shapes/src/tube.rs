@@ -203,6 +203,10 @@ impl TubeInterior {
         if (q - self.end).dot(self.end_dir) > 0.0 && self.closer_to_end(q, self.end) {
             return None;
         }
+        // One segment (a plain bend): no comparison, nothing copied.
+        if let [seg] = self.segments.as_slice() {
+            return Some(nearest_on_segment(seg, q));
+        }
         let mut best: Option<(f64, CentrelinePoint)> = None;
         for seg in &self.segments {
             let c = nearest_on_segment(seg, q);
@@ -335,6 +339,7 @@ fn segment_aabb(seg: &Segment) -> (Vector, Vector) {
     }
 }
 
+#[inline]
 pub(crate) fn nearest_on_segment(seg: &Segment, q: Vector) -> CentrelinePoint {
     match *seg {
         Segment::Straight { start, dir, length } => {

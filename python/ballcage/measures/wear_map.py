@@ -112,15 +112,21 @@ class _Poses:
             raise InputError("the contacts table has frames the bodies table lacks; record both at one interval")
         return i
 
-    def body_of(self, body_a: list[str], body_b: list[str]) -> np.ndarray:
-        """The recorded, non-key body of each pair (−1 where neither is recorded)."""
-
-        def code(n: str) -> int:
-            return self.code.get(n, -1) if n not in self.keys else -1
-
-        a = np.array([code(n) for n in body_a], dtype=int)
-        b = np.array([code(n) for n in body_b], dtype=int)
+    def body_of(self, body_a: pa.ChunkedArray, body_b: pa.ChunkedArray) -> np.ndarray:
+        """The recorded, non-key body of each pair (−1 where neither is recorded); the body names as Arrow columns."""
+        a, b = self._codes(body_a), self._codes(body_b)
         return np.where(a >= 0, a, b)
+
+    def _codes(self, names: pa.ChunkedArray) -> np.ndarray:
+        """Each name's body code, −1 for a key or a body not recorded: looked up once per distinct name."""
+        if pa.types.is_dictionary(names.type):
+            names = names.unify_dictionaries()
+        column = names.combine_chunks()
+        if not pa.types.is_dictionary(column.type):
+            column = column.dictionary_encode()
+        lut = np.array([self.code.get(n, -1) if n not in self.keys else -1 for n in column.dictionary.to_pylist()],
+                       dtype=int)  # fmt: skip
+        return lut[column.indices.to_numpy(zero_copy_only=False)]
 
     def local(self, frame: np.ndarray, body: np.ndarray, points: np.ndarray) -> np.ndarray:
         pose = self.pose[frame, body]
@@ -135,7 +141,7 @@ def _contacts(run: Run, pair_ids: set[int]) -> dict[str, Any] | None:
     out: dict[str, Any] = {}
     for c in _CONTACT_COLUMNS:
         col = table.column(c)
-        out[c] = [str(v) for v in col.to_pylist()] if c.startswith("body") else col.to_numpy()
+        out[c] = col if c.startswith("body") else col.to_numpy()
     out["point"] = np.column_stack([out.pop(f"point_{a}") for a in "xyz"])
     tangential = np.column_stack([out.pop(f"tangential_force_{a}") for a in "xyz"])
     out["power"] = np.linalg.norm(tangential, axis=1) * out["slip_speed"] * np.sign(out["normal_force"])
@@ -213,7 +219,8 @@ def _key_part(run: Run, ids: dict[int, dict[str, Any]], poses: _Poses, cfg: dict
     x = poses.local(frame[keep], body[keep], rows["point"][keep])[:, 0]
     pair = rows["pair_id"][keep].astype(int)
     f = rows["normal_force"][keep]
-    peak = np.array([[ids[p]["semi_major"], ids[p]["semi_minor"], ids[p]["pressure_peak_force"]] for p in pair])
+    pairs, which = np.unique(pair, return_inverse=True)
+    peak = np.array([[ids[p]["semi_major"], ids[p]["semi_minor"], ids[p]["pressure_peak_force"]] for p in pairs])[which]
     scale = np.cbrt(f / peak[:, 2])
     root_pi = math.sqrt(math.pi) / 2.0
     across, along = peak[:, 0] * scale * root_pi, peak[:, 1] * scale * root_pi

@@ -19,7 +19,7 @@ import pyarrow as pa
 from ballcage.studies.schemas import SENSITIVITY_SCHEMA
 from ballcage.studies.sensitivity_design import Design, problem, salib
 from ballcage.studies.sensitivity_parameters import ParameterRange
-from ballcage.studies.sweep_summary import COST_COLUMNS
+from ballcage.studies.sweep_summary import COST_COLUMNS, RUN_OF_COLUMN
 
 __all__ = ["morris_indices", "numerical_error", "sensitivity_table"]
 
@@ -35,7 +35,7 @@ def sensitivity_table(
     `base_meta` is the base run's metadata (for the integrator's error estimate); `parameters` the sweep's swept keys.
     """
     rows = {int(r["case"]): r for r in summary.to_pylist()}
-    skip = {*_HEAD_COLUMNS, *parameters, *(c[0] for c in COST_COLUMNS)}
+    skip = {*_HEAD_COLUMNS, *parameters, *(c[0] for c in (*COST_COLUMNS, RUN_OF_COLUMN))}
     units = {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in summary.schema}
     out: list[dict[str, Any]] = []
     for quantity in (c for c in summary.column_names if c not in skip):

@@ -178,13 +178,16 @@ def moves(rows: list[dict[str, Any]]) -> bool:
 
 def _method_text(meta: Mapping[str, str]) -> str:
     runs = meta.get("ballcage.sensitivity.runs", "")
+    shared = int(meta.get("ballcage.sensitivity.shared_runs", "0") or 0)
+    tail = (f"; {shared} of them not simulated: their scene's engine digest is another run's, so their quantities "
+            "come from that run's tables") if shared else ""
     if meta.get("ballcage.sensitivity.method") == "morris":
         return (
             f"Method: Morris elementary effects (SALib's design and analysis), "
             f"{meta.get('ballcage.sensitivity.trajectories')} trajectories on {meta.get('ballcage.sensitivity.levels')} "
-            f"levels, seed {meta.get('ballcage.sensitivity.seed')}, and the base run: {runs} runs."
+            f"levels, seed {meta.get('ballcage.sensitivity.seed')}, and the base run: {runs} runs{tail}."
         )
-    return f"Method: one at a time (OAT), the base run and each parameter at its low and at its high value: {runs} runs."
+    return f"Method: one at a time (OAT), the base run and each parameter at its low and at its high value: {runs} runs{tail}."
 
 
 def _effect_text(method: str) -> str:

@@ -75,9 +75,9 @@ from ballcage.studies.sensitivity_design import (
 )
 from ballcage.studies.sensitivity_effects import sensitivity_table
 from ballcage.studies.sensitivity_parameters import ParameterChoice, parameter_ranges
-from ballcage.studies.sensitivity_quantities import for_scene, tables_for
+from ballcage.studies.sensitivity_quantities import LIVES_SECONDS_PER_SIMULATED_SECOND, for_scene, tables_for
 from ballcage.studies.sweep_case import PART, read_record, table_path
-from ballcage.studies.sweep_run import SweepResult, checked_case_timeout, pending_cases, sweep
+from ballcage.studies.sweep_run import SweepResult, checked_case_timeout, pending_work, shared_runs, sweep
 from ballcage.studies.sweep_spec import SweepError, SweepSpec, partition_name
 
 __all__ = ["PLOTS", "REPORT_FILE", "RUNS", "TABLE_FILE", "Sensitivity", "describe", "sensitivity"]
@@ -168,17 +168,22 @@ def sensitivity(
     spec.check()
     runs = folder / RUNS
     per_run = _per_run(base, runs)
-    estimate = _estimate(per_run, design, runs, pending_cases(spec, runs), workers, client)
+    estimate = _estimate(per_run, design, runs, pending_work(spec, runs), workers, client,
+                         _lives_rate(base) * base.duration)  # fmt: skip
     if case_timeout == "auto":
         limit = _default_case_timeout(per_run[0], design)
     say: Callable[[str], None] = _say if progress is not False else (lambda _: None)
-    say(_plan(base, design, estimate, limit, case_timeout == "auto"))
+    run_of = shared_runs(spec, spec.cases())
+    say(_plan(base, design, estimate, limit, case_timeout == "auto", sum(1 for k, v in run_of.items() if k != v)))
     quantities = for_scene(base)
     result = sweep(spec, runs, client=client, workers=workers, plots=False, progress=progress, quantities=quantities,
                    case_timeout=limit)  # fmt: skip
     table = sensitivity_table(result.summary, design, _base_metadata(runs), spec.parameters)
     call = command or _python_call(scene, folder, design, patches, verify, False if case_timeout == "auto" else limit)
     meta = _file_metadata(base, design, patches, call, limit)
+    meta["ballcage.sensitivity.shared_runs"] = str(
+        sum(1 for r in result.summary.to_pylist() if r["run_of"] != r["case"] and design.roles[r["case"]].kind != "verify")
+    )
     table = table.replace_schema_metadata({**meta, **(SENSITIVITY_SCHEMA.metadata or {})} | _units_metadata())
     paths = _write(table, folder, plots)
     return Sensitivity(table, folder, paths, result, estimate[0], time.perf_counter() - start, limit)
@@ -206,25 +211,38 @@ def _default_case_timeout(per_run: float | None, design: Design) -> float | None
 
 
 def _per_run(base: _native.Scene, runs: Path) -> tuple[float | None, str]:
-    """Seconds one run of the study should take and what that rests on; None when nothing tells (a scene of bodies
-    whose base run has not run yet)."""
+    """Seconds one run of the study should take, its quantities included, and what that rests on; None when nothing
+    tells (a scene of bodies whose base run has not run yet)."""
     per_run, basis = _base_wall_time(runs), "at the base run's measured time"
     if per_run is None and base.kind == "drill-pipe":
         from ballcage.studies.design_chart import SECONDS_PER_SIMULATED_SECOND
 
         hinge = str(base.value("pipe.hinge"))
-        rate = SECONDS_PER_SIMULATED_SECOND.get(hinge, 10.0)
+        rate = SECONDS_PER_SIMULATED_SECOND.get(hinge, 10.0) + _lives_rate(base)
         per_run = rate * base.duration
-        basis = (f"{hinge}, {base.duration:g} s each at ~{rate:g} s per simulated s on one core of a 2-core AMD EPYC; "
-                 "a rough guide")
+        basis = (f"{hinge}, {base.duration:g} s each at ~{rate:g} s per simulated s on one core of a 2-core AMD EPYC, "
+                 "the lives included; a rough guide")
     return per_run, basis
 
 
+def _lives_rate(base: _native.Scene) -> float:
+    """Seconds per simulated second [–] a drill pipe's fatigue and wear lives take (`LIVES_SECONDS_PER_SIMULATED_SECOND`)."""
+    return LIVES_SECONDS_PER_SIMULATED_SECOND.get(str(base.value("pipe.hinge")), 1.0) if base.kind == "drill-pipe" else 0.0
+
+
 def _estimate(
-    one_run: tuple[float | None, str], design: Design, runs: Path, pending: int, workers: int | None, client: Any
+    one_run: tuple[float | None, str],
+    design: Design,
+    runs: Path,
+    pending: tuple[int, int],
+    workers: int | None,
+    client: Any,
+    lives: float = 0.0,
 ) -> tuple[float | None, str]:
-    """Seconds the pending runs should take and what that rests on (`_per_run`); None when nothing tells."""
+    """Seconds the pending runs (and the cases that share them, at `lives` seconds each) should take and what that
+    rests on (`_per_run`); None when nothing tells."""
     per_run, basis = one_run
+    pending, shared = pending
     if per_run is None:
         return None, ""
     if client is not None:
@@ -235,8 +253,10 @@ def _estimate(
     check = _check_weight(design.check) if design.check is not None and _pending(runs, len(design.roles) - 1) else 0.0
     work = pending - (1 if check else 0) + check
     seconds = per_run * max(math.ceil(work / parallel), check) if work > 0 else 0.0
+    seconds += lives * shared  # in the worker of the run they share, one after another
     where = "on the Dask cluster" if client is not None else f"in {parallel} local threads"
-    return seconds, f"{pending} runs to run {where}, {basis}"
+    also = f" and {shared} cases from their runs" if shared else ""
+    return seconds, f"{pending} runs to run{also} {where}, {basis}"
 
 
 def _check_weight(setting: Tighter) -> float:
@@ -257,9 +277,11 @@ def _base_wall_time(runs: Path) -> float | None:
 
 
 def _plan(
-    base: _native.Scene, design: Design, estimate: tuple[float | None, str], limit: float | None, auto: bool
+    base: _native.Scene, design: Design, estimate: tuple[float | None, str], limit: float | None, auto: bool,
+    shared: int = 0,
 ) -> str:
-    """The line printed before the study runs: what it runs, how long it should take and each run's time limit."""
+    """The line printed before the study runs: what it runs, how long it should take and each run's time limit;
+    `shared`: the cases that share another case's run (`shared_runs`)."""
     p = len(design.ranges)
     what = (
         "the base and each parameter at its low and its high value"
@@ -269,6 +291,10 @@ def _plan(
     if design.check is not None:
         what += f", and the base at {design.check.label} for the numerical error"
     head = f"sensitivity ({design.method}) to {p} parameters of the {base.kind} scene: {len(design.roles)} runs ({what})"
+    if shared:
+        head += (f"; {shared} of them not run but computed from another run's tables: their scene's engine digest is "
+                 "that run's (the parameter enters only what is computed from the tables, or nothing this scene "
+                 "builds)")
     seconds, basis = estimate
     if seconds is None:
         plan = f"{head}; no estimate before the base run of a scene of bodies has finished (the progress shows the time left)"
@@ -390,7 +416,9 @@ def describe(result: Sensitivity) -> Iterable[str]:
         yield f"wrote {len(charts)} tornado charts in {charts[0].parent}"
     yield f"wrote {result.sweep.paths['summary']}  (the study's runs, one row each)"
     guess = f", estimated {_duration(result.estimate_s)}" if result.estimate_s is not None else ""
+    shared = result.sweep.shared
+    reused = f" ({shared} of them not simulated: from another run's tables, the same engine digest)" if shared else ""
     yield (
-        f"ballcage: {result.sweep.ran} runs run, {result.sweep.skipped} skipped (already finished), "
+        f"ballcage: {result.sweep.ran} runs run{reused}, {result.sweep.skipped} skipped (already finished), "
         f"{result.failed} not ok; {_duration(result.elapsed_s)} in all{guess}"
     )

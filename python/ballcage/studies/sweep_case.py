@@ -11,7 +11,11 @@ temporary name and renamed, so a file under its final name is complete, and a
 case with a record is finished. A run that diverges keeps what it recorded up
 to then (status ``diverged``); so does a run stopped at the case's time limit
 (``CaseTask.timeout``, ``--case-timeout``: status ``timed-out``); any other
-failure is status ``error``; none is raised.
+failure is status ``error``; none is raised. A case whose scene has the
+same engine digest as an earlier case's (`Scene.engine_digest`) is not run:
+the worker of that case computes its quantities from that run with its own
+scene (`derive_case`) and writes its scene and record (``run_of``: the case
+whose tables it reads), no tables of its own.
 """
 
 from __future__ import annotations
@@ -31,7 +35,8 @@ from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
 from ballcage.studies.sweep_spec import partition_name, toml_value
 
 __all__ = [
-    "TIMED_OUT", "CaseTask", "read_case_run", "read_record", "record_path", "run_case", "scene_path", "write_record",
+    "TIMED_OUT", "CaseTask", "derive_case", "read_case_run", "read_record", "record_path", "run_case", "scene_path",
+    "write_record",
 ]
 
 #: Name of every table file inside a case's partition directory.
@@ -57,6 +62,7 @@ class CaseTask:
     out: str  # the sweep's output folder
     quantities: SweepQuantities = GENERIC  # what the record's "quantities" hold (pickled with the task)
     timeout: float | None = None  # s of wall time the case's run may take (--case-timeout); None: no limit
+    shares: tuple[CaseTask, ...] = ()  # cases with this one's engine digest, derived from its run (`derive_case`)
 
 
 def record_path(out: Path, partition: str) -> Path:
@@ -69,14 +75,20 @@ def table_path(out: Path, table: str, partition: str) -> Path:
 
 
 def run_case(task: CaseTask) -> dict[str, Any]:
-    """Runs one case, writes its tables, scene and record into ``task.out``; returns the record (a dict)."""
+    """Runs one case, writes its tables, scene and record into ``task.out``; returns the record (a dict).
+
+    The cases of ``task.shares`` (the same engine digest) are not run: `derive_case` gives their records from this
+    run, under the record's ``"shared"``. Tables the quantities plug-in reads beyond the case's ``record.tables``
+    (its ``memory_tables``) are recorded for the quantities and not written.
+    """
     start = time.perf_counter()
     out = Path(task.out)
     scene = _native.Scene.from_toml(task.base_toml, list(task.overrides))
     run: Run | None = None
     status, error = "ok", None
+    kept = [str(t) for t in scene.value("record.tables")] if scene.kind == "drill-pipe" else None
     try:
-        run = simulate(scene, progress=False, time_limit=task.timeout)
+        run = simulate(_with_tables(task, scene, kept), progress=False, time_limit=task.timeout)
     except _native.SimulationError as e:
         run, status, error = getattr(e, "run", None), "diverged", str(e)
     except TimeLimitError as e:
@@ -86,24 +98,76 @@ def run_case(task: CaseTask) -> dict[str, Any]:
     record = _base_record(task, scene, status, error)
     try:
         if run is not None:
-            record["tables"] = _write_tables(run, out, task.partition)
+            record["tables"] = _write_tables(run, out, task.partition, kept)
             record.update(_cost(run))
             record["quantities"] = task.quantities(run)
     except Exception as e:  # noqa: BLE001
         record["status"], record["error"] = "error", _join(error, f"after the run: {_describe(e)}")
-    path = scene_path(out, task.partition)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_text(scene.to_toml(units=True) if scene.kind == "drill-pipe" else scene.to_toml(), path)
+    _write_scene(out, task.partition, scene)
+    record["case_wall_time_s"] = time.perf_counter() - start
+    write_record(out, record)
+    record["shared"] = [derive_case(t, record, run) for t in task.shares]
+    return record
+
+
+def _with_tables(task: CaseTask, scene: _native.Scene, kept: list[str] | None) -> _native.Scene:
+    """`scene`, recording also the tables the quantities plug-in reads (``memory_tables``) that it does not."""
+    extra = [t for t in getattr(task.quantities, "memory_tables", ()) if kept is not None and t not in kept]
+    if not extra:
+        return scene
+    return _native.Scene.from_toml(task.base_toml, [*task.overrides, f"record.tables={toml_value([*kept, *extra])}"])
+
+
+def derive_case(task: CaseTask, source: dict[str, Any], run: Run | None) -> dict[str, Any]:
+    """The record of a case that shares the `run` of the case of record `source` (the same `Scene.engine_digest`):
+    its quantities from that run's tables with its own scene, bitwise what running it would give (the engine is
+    deterministic); its status and error are that run's. Writes its scene and record into ``task.out``; no tables
+    (``run_of`` names the case whose tables it reads)."""
+    start = time.perf_counter()
+    out = Path(task.out)
+    scene = _native.Scene.from_toml(task.base_toml, list(task.overrides))
+    record = _base_record(task, scene, source["status"], source.get("error"))
+    record["run_of"] = int(source["case"])
+    try:
+        if run is not None:
+            own = Run(run.tables, _scene_text(scene), error=source.get("error"))
+            record.update(_cost(own))
+            record["wall_time_s"] = None  # no simulation of its own
+            record["quantities"] = task.quantities(own)
+    except Exception as e:  # noqa: BLE001 - recorded, never raised
+        record["status"], record["error"] = "error", _join(source.get("error"), f"after the run: {_describe(e)}")
+    _write_scene(out, task.partition, scene)
     record["case_wall_time_s"] = time.perf_counter() - start
     write_record(out, record)
     return record
 
 
+def _scene_text(scene: _native.Scene) -> str:
+    return scene.to_toml(units=True) if scene.kind == "drill-pipe" else scene.to_toml()
+
+
+def _write_scene(out: Path, partition: str, scene: _native.Scene) -> None:
+    path = scene_path(out, partition)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_text(_scene_text(scene), path)
+
+
 def read_case_run(out: Path, index: int) -> Run:
     """The run of finished case `index` of the sweep in `out`, read back from its record, tables and scene.
 
-    Raises `FileNotFoundError` when the case has no record (it has not finished).
+    A case that shares another case's run (its record's ``run_of``, `derive_case`) has that case's tables with its
+    own scene. Raises `FileNotFoundError` when the case (or the case whose run it shares) has no record.
     """
+    partition = partition_name(index)
+    record = read_record(out, partition)
+    if record is None:
+        raise FileNotFoundError(f"{record_path(out, partition)}: no record of case {index} (not finished)")
+    scene_toml = scene_path(out, partition).read_text(encoding="utf-8")
+    return _tables_run(out, int(record.get("run_of", index)), scene_toml, record.get("error"))
+
+
+def _tables_run(out: Path, index: int, scene_toml: str, error: str | None) -> Run:
+    """The tables case `index` recorded, read back, as a run of the scene `scene_toml`."""
     import pyarrow.parquet as pq  # deferred: only readers pay for it
 
     partition = partition_name(index)
@@ -111,8 +175,7 @@ def read_case_run(out: Path, index: int) -> Run:
     if record is None:
         raise FileNotFoundError(f"{record_path(out, partition)}: no record of case {index} (not finished)")
     tables = {name: pq.read_table(table_path(out, name, partition)) for name in record.get("tables", [])}
-    scene_toml = scene_path(out, partition).read_text(encoding="utf-8")
-    return Run(tables, scene_toml, error=record.get("error"))
+    return Run(tables, scene_toml, error=error)
 
 
 def failed_record(task: CaseTask, error: BaseException) -> dict[str, Any]:
@@ -134,12 +197,16 @@ def _base_record(task: CaseTask, scene: _native.Scene, status: str, error: str |
         "error": error,
         "tables": [],
         "quantities": {},
+        "run_of": task.index,
     }
 
 
-def _write_tables(run: Run, out: Path, partition: str) -> list[str]:
+def _write_tables(run: Run, out: Path, partition: str, kept: list[str] | None = None) -> list[str]:
+    """Writes the run's tables (those of `kept` when given) into the case's partitions; their names."""
     names = []
     for name, table in run.tables.items():
+        if kept is not None and name not in kept:
+            continue
         path = table_path(out, name, partition)
         path.parent.mkdir(parents=True, exist_ok=True)
         write_parquet(table, path)

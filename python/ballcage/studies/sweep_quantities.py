@@ -56,6 +56,9 @@ class SweepQuantities(Protocol):
         """The quantities of one case's run, complete or partial; ``None`` where a value is not computed."""
         ...
 
+    # A plug-in may also name tables it reads beyond the sweep's, ``memory_tables: tuple[str, ...]``: each drill-pipe
+    # run records them for the plug-in and the sweep does not keep them (`ballcage.studies.sweep_case.run_case`).
+
 
 class GenericQuantities:
     """The plug-in of scenes of bodies: no quantities (the summary holds the swept values and the cost)."""

@@ -8,6 +8,11 @@ Output folder (docs/studies.md)::
     DIR/cases/case=NNNN.scene.toml           the case's resolved scene
     DIR/plots/<parameter>.png                each quantity against each swept parameter
 
+A case whose scene has the same engine digest as an earlier case's
+(`Scene.engine_digest`: bitwise the same run) is not run again: its
+quantities come from that case's tables with its own scene (`shared_runs`,
+`ballcage.studies.sweep_case.derive_case`; the summary's ``run_of``).
+
 Each case's quantities (``summary.parquet``'s columns after the swept keys)
 come from a plug-in, `ballcage.studies.sweep_quantities.SweepQuantities`:
 by default the one of the base scene's kind (`for_scene`).
@@ -29,7 +34,7 @@ import time
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -52,7 +57,10 @@ from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities, for_scen
 from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec, load_sweep
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
-__all__ = ["SweepResult", "checked_case_timeout", "connect", "pending_cases", "scheduler_client", "sweep"]
+__all__ = [
+    "SweepResult", "checked_case_timeout", "connect", "pending_cases", "pending_work", "scheduler_client", "shared_runs",
+    "sweep",
+]
 
 
 @dataclass
@@ -65,6 +73,9 @@ class SweepResult:
     skipped: int
     failed: int
     paths: dict[str, Path] = field(default_factory=dict)
+    #: Of the cases `ran`, those that shared another case's run (`shared_runs`): their quantities were computed from
+    #: its tables, no simulation of their own.
+    shared: int = 0
 
 
 def sweep(
@@ -108,28 +119,73 @@ def sweep(
         raise SweepError(f"--out {folder}: exists and is not a directory")
     base = _native.Scene.from_toml(loaded.base_toml)
     plugin = quantities if quantities is not None else for_scene(base)
-    tasks = [_task(loaded, c, folder, plugin, timeout) for c in cases]
-    pending, done = _split_finished(tasks, folder, retry_failed)
+    pending, done = _pending_runs([_task(loaded, c, folder, plugin, timeout) for c in cases],
+                                  shared_runs(loaded, cases), folder, retry_failed)  # fmt: skip
     say = _Say(progress is not False)
     where = _where(client, workers)
     limit = f", each stopped past {timeout:g} s of wall time (--case-timeout)" if timeout is not None else ""
-    say(f"sweep {loaded.name}: {len(tasks)} cases; {len(done)} already finished in {folder} (skipped), "
-        f"running {len(pending)} {where}{limit}")
+    shared = sum(len(t.shares) for t in pending)
+    reuse = f" (and {shared} cases from their runs: the same engine digest, Scene.engine_digest)" if shared else ""
+    say(f"sweep {loaded.name}: {len(cases)} cases; {len(done)} already finished in {folder} (skipped), "
+        f"running {len(pending)}{reuse} {where}{limit}")
     folder.mkdir(parents=True, exist_ok=True)
     bar = SweepProgress(len(pending), enabled=progress is not False)
     try:
-        records = done + (_run_dask(client, pending, bar) if client is not None else _run_local(pending, workers, bar))
+        ran = _run_dask(client, pending, bar) if client is not None else _run_local(pending, workers, bar)
     finally:
         bar.close()
-    return _finish(loaded, base, plugin, records, folder, (len(pending), len(done)), plots)
+    records = done + [r for record in ran for r in (record, *record.pop("shared", []))]
+    result = _finish(loaded, base, plugin, records, folder, (len(pending) + shared, len(done)), plots)
+    result.shared = shared
+    return result
+
+
+def _pending_runs(
+    tasks: list[CaseTask], run_of: dict[int, int], out: Path, retry_failed: bool
+) -> tuple[list[CaseTask], list[dict[str, Any]]]:
+    """The runs still to run, each with the cases that share it (`CaseTask.shares`), and the finished records.
+
+    A run is run again, with all its cases, when any of them is unfinished (`_split_finished`): a shared case is
+    computed from its run in memory, with tables its plug-in reads that the sweep does not keep.
+    """
+    unfinished, finished = _split_finished(tasks, out, retry_failed)
+    again = {run_of[t.index] for t in unfinished}
+    by_index = {t.index: t for t in tasks}
+    pending = [
+        replace(by_index[i], shares=tuple(t for t in tasks if run_of[t.index] == i and t.index != i))
+        for i in sorted(again)
+    ]
+    done = [r for r in finished if run_of[int(r["case"])] not in again]
+    return pending, done
+
+
+def shared_runs(spec: SweepSpec, cases: Iterable[Case]) -> dict[int, int]:
+    """Case index -> the first case whose scene has the same engine digest (`Scene.engine_digest`; itself if none).
+
+    Two such scenes record bitwise the same tables, so only the first is run; the others differ only in what is
+    computed from the tables afterwards (e.g. ``fatigue.*``) or in nothing the scene builds.
+    """
+    first: dict[str, int] = {}
+    out: dict[int, int] = {}
+    for case in cases:
+        digest = _native.Scene.from_toml(spec.base_toml, list(case.overrides)).engine_digest()
+        out[case.index] = first.setdefault(digest, case.index)
+    return out
 
 
 def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
-    """How many cases of the sweep `spec` are not yet finished in the folder `out` (all of them in a new folder)."""
+    """How many runs the sweep `spec` has still to run in the folder `out` (`pending_work`)."""
+    return pending_work(spec, out)[0]
+
+
+def pending_work(spec: SweepSource, out: str | os.PathLike[str]) -> tuple[int, int]:
+    """What the sweep `spec` has still to do in the folder `out`: the runs, and the cases computed from them that
+    share their run (`shared_runs`; no simulation, only their quantities)."""
     loaded = load_sweep(spec)
     folder = Path(out)
-    pending, _ = _split_finished([_task(loaded, c, folder) for c in loaded.cases()], folder, retry_failed=False)
-    return len(pending)
+    cases = loaded.cases()
+    pending, _ = _pending_runs([_task(loaded, c, folder) for c in cases], shared_runs(loaded, cases), folder, False)
+    return len(pending), sum(len(t.shares) for t in pending)
 
 
 def checked_case_timeout(value: float | str | None) -> float | None:
@@ -237,9 +293,10 @@ def _result(get: Callable[[], dict[str, Any]], task: CaseTask) -> dict[str, Any]
     try:
         return get()
     except Exception as e:  # noqa: BLE001 - e.g. a worker lost; the sweep goes on
-        record = failed_record(task, e)
-        write_record(Path(task.out), record)
-        return record
+        records = [failed_record(t, e) for t in (task, *task.shares)]
+        for record in records:
+            write_record(Path(task.out), record)
+        return records[0] | {"shared": records[1:]}
 
 
 def _finish(
@@ -324,8 +381,9 @@ def describe(result: SweepResult) -> Iterable[str]:
     for name, path in result.paths.items():
         if name.startswith("plot_"):
             yield f"wrote {path}  (plot)"
+    shared = f" ({result.shared} of them from another case's run: the same engine digest)" if result.shared else ""
     yield (
-        f"ballcage: {result.ran} cases run, {result.skipped} skipped (already finished), "
+        f"ballcage: {result.ran} cases run{shared}, {result.skipped} skipped (already finished), "
         f"{result.failed} of {result.summary.num_rows} not ok"
     )
 

@@ -11,7 +11,7 @@ import pyarrow as pa
 from ballcage import _native
 from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
 
-__all__ = ["COST_COLUMNS", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
+__all__ = ["COST_COLUMNS", "RUN_OF_COLUMN", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
 
 #: Columns that measure wall time: the only ones two runs of the same sweep may differ in.
 WALL_TIME_COLUMNS: tuple[str, ...] = ("wall_time_s", "case_wall_time_s")
@@ -27,8 +27,15 @@ _HEAD: tuple[tuple[str, pa.DataType, str, str], ...] = (
 COST_COLUMNS: tuple[tuple[str, pa.DataType, str, str], ...] = (
     ("steps", pa.int64(), "", "integrator steps taken (ballcage.steps)"),
     ("simulated_time_s", pa.float64(), "s", "simulated time reached: steps x dt"),
-    ("wall_time_s", pa.float64(), "s", "wall time of the simulation alone (ballcage.wall_time_s)"),
+    ("wall_time_s", pa.float64(), "s", "wall time of the simulation alone (ballcage.wall_time_s); null for a case that "
+     "shares another case's run (run_of)"),
     ("case_wall_time_s", pa.float64(), "s", "wall time of the whole case: scene, run, tables written, quantities"),
+)
+#: The last column: which case's run gave a case its tables (`ballcage.studies.sweep_run.shared_runs`).
+RUN_OF_COLUMN: tuple[str, pa.DataType, str, str] = (
+    "run_of", pa.int32(), "", "the case whose run gave this case's tables: its own index, or an earlier case's whose "
+    "scene has the same engine digest (Scene.engine_digest: bitwise the same run), so only what is computed from the "
+    "tables afterwards differs",
 )
 
 
@@ -71,7 +78,7 @@ def summary_table(
         add(key, [r.get("parameters", {}).get(key) for r in rows], None, units.get(key, ""), f"scene key {key} (swept)")
     for name, (unit, description) in _quantity_columns(rows, quantities).items():
         add(name, [r.get("quantities", {}).get(name) for r in rows], pa.float64(), unit, description)
-    for name, kind, unit, description in COST_COLUMNS:
+    for name, kind, unit, description in (*COST_COLUMNS, RUN_OF_COLUMN):
         add(name, [r.get(name) for r in rows], kind, unit, description)
     schema = pa.schema(fields)
     file_meta = dict(meta)
