@@ -36,8 +36,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BODIES_SENSITIVITY", "DRILL_PIPE_SENSITIVITY", "LIVES", "LIVES_SECONDS_PER_SIMULATED_SECOND", "PRESSURE_MARGIN",
-    "BodiesSensitivity",
-    "DrillPipeSensitivity", "depth_peaks", "for_scene", "lives", "tables_for",
+    "BodiesSensitivity", "DrillPipeSensitivity", "depth_peaks", "for_scene", "lives", "tables_for",
 ]
 
 #: The smallest contact-pressure margin: name -> (unit, meaning).
