@@ -13,6 +13,7 @@ tenth of a second per run) and two parameters with explicit ranges:
 from __future__ import annotations
 
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -346,3 +347,29 @@ def test_paper_refuses_a_missing_sensitivity_file(tmp_path: Path) -> None:
     proc = _cli("paper", "--out", str(tmp_path / "p"), "--sensitivity", str(tmp_path / "none.parquet"))
     assert proc.returncode == 2 and "--sensitivity" in proc.stderr and "no such file" in proc.stderr, proc.stderr
     assert len(proc.stderr.strip().splitlines()) == 1 and "Traceback" not in proc.stderr
+
+
+def _chart_rows(values: list[tuple[float, float]], base: float) -> list[dict]:
+    """OAT rows of one quantity (unit h) for `tornado_figure`: one parameter per (low, high) value pair."""
+    return [
+        {"method": "oat", "parameter": f"p{k}", "parameter_unit": "m", "parameter_base": 1.0, "parameter_low": 0.5,
+         "parameter_high": 2.0, "quantity": "life_h", "unit": "h", "base": base, "value_low": lo, "value_high": hi,
+         "effect": max(abs(lo - base), abs(hi - base)), "rank": k + 1, "below_error": False,
+         "numerical_error": 1e-3 * base, "numerical_error_source": "given", "mu_star": None, "mu": None,
+         "sigma": None, "mu_star_conf": None}
+        for k, (lo, hi) in enumerate(values)
+    ]  # fmt: skip
+
+
+def test_a_quantity_spanning_decades_is_charted_in_decades_and_a_narrow_one_linearly() -> None:
+    from ballcage.studies.sensitivity_plot import tornado_figure
+
+    wide = tornado_figure(_chart_rows([(1e-3, 2e2), (50.0, 150.0)], 100.0))  # 5.3 decades: a fatigue life
+    ax = wide.axes[0]
+    assert "decades" in ax.get_xlabel()
+    widths = sorted(round(p.get_width(), 12) for p in ax.patches if p.get_height() == pytest.approx(0.32))
+    assert widths == sorted(round(math.log10(v / 100.0), 12) for v in (1e-3, 2e2, 50.0, 150.0))
+    narrow = tornado_figure(_chart_rows([(50.0, 150.0)], 100.0))  # half a decade
+    assert "decades" not in narrow.axes[0].get_xlabel()
+    widths = sorted(round(p.get_width(), 12) for p in narrow.axes[0].patches if p.get_height() == pytest.approx(0.32))
+    assert widths == [-50.0, 50.0]

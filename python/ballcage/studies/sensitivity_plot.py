@@ -3,7 +3,8 @@
 Each parameter is a row, the largest effect at the top. One at a time (OAT):
 two bars from the base value, the change with the parameter at its low
 value and at its high value, in the quantity's unit (the top axis in per cent
-of the base). Morris: a bar of mu_star with its 95 % confidence interval and
+of the base), or in decades, log10(value / base), for a quantity whose
+values span more than two decades (a fatigue life: `spans_decades`). Morris: a bar of mu_star with its 95 % confidence interval and
 a diamond at sigma. The base run's numerical error is a row of its own (a
 hatched red bar) and a shaded band across every row: a parameter whose effect
 lies inside it is drawn grey and labelled "below the numerical error". A
@@ -16,6 +17,7 @@ moves.
 
 from __future__ import annotations
 
+import math
 import re
 import textwrap
 from pathlib import Path
@@ -27,9 +29,11 @@ from ballcage._files import write_png
 from ballcage._plot import figure
 from ballcage.studies.sensitivity_report import by_quantity, moves
 
-__all__ = ["chart_name", "tornado_figure", "write_tornados"]
+__all__ = ["DECADES", "chart_name", "spans_decades", "tornado_figure", "write_tornados"]
 
 _LOW, _HIGH, _GREY, _ERROR = "#1f77b4", "#ff7f0e", "#c0c0c0", "#d62728"
+#: A quantity whose values span more decades than this is charted in decades (`spans_decades`).
+DECADES = 2.0
 #: Characters a chart's file name does not keep.
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.\-]")
 
@@ -56,9 +60,12 @@ def tornado_figure(rows: list[dict[str, Any]]) -> Any:
     ordered = sorted(rows, key=lambda r: (r["effect"] is None, -(r["effect"] or 0.0)))
     fig = figure(figsize=(8.0, 1.9 + 0.55 * (len(ordered) + 1)))
     ax = fig.subplots()
-    error = first["numerical_error"]
     unit = _unit(first["unit"])
     morris = first["method"] == "morris"
+    decades = not morris and spans_decades(rows)
+    error = first["numerical_error"]
+    if error is not None and decades:
+        error = math.log10(1.0 + error / first["base"])
     if error is not None:
         lo = 0.0 if morris else -error
         ax.axvspan(lo, error, color=_ERROR, alpha=0.08, lw=0)
@@ -70,7 +77,7 @@ def tornado_figure(rows: list[dict[str, Any]]) -> Any:
         if morris:
             _morris_row(ax, y, row, grey, seen)
         else:
-            _oat_row(ax, y, row, first["base"], grey, seen)
+            _oat_row(ax, y, row, first["base"], grey, seen, decades)
     if error is not None:
         ax.barh(0, error - (0.0 if morris else -error), left=0.0 if morris else -error, height=0.6, color="white",
                 edgecolor=_ERROR, hatch="///", label="numerical error of the base run")
@@ -78,14 +85,16 @@ def tornado_figure(rows: list[dict[str, Any]]) -> Any:
         ax.text(0.5, 0, "numerical error: no estimate", transform=ax.get_yaxis_transform(), ha="center",
                 va="center", color=_ERROR, fontsize="small")
     ax.axvline(0.0, color="black", lw=0.8)
-    ax.set_yticks(range(n, -1, -1), [_row_label(r) for r in ordered] + [_error_label(error, unit, morris)],
-                  fontsize="small")
+    ax.set_yticks(range(n, -1, -1), [_row_label(r) for r in ordered] + [_error_label(first["numerical_error"], unit,
+                  morris)], fontsize="small")  # fmt: skip
     for tick, row in zip(ax.get_yticklabels(), ordered, strict=False):
         if row["below_error"]:
             tick.set_color("grey")
     ax.set_ylim(-0.7, n + 0.7)
     if morris:
         ax.set_xlabel(f"elementary effect over the parameter's whole range [{unit}]")
+    elif decades:
+        ax.set_xlabel("change from the base run [decades: log10(value / base)]")
     else:
         ax.set_xlabel(f"change from the base run [{unit}]")
         base = first["base"]
@@ -117,14 +126,25 @@ def _once(label: str, seen: set[str]) -> str | None:
     return label
 
 
-def _oat_row(ax: Any, y: float, row: dict[str, Any], base: float | None, grey: bool, seen: set[str]) -> None:
+def spans_decades(rows: list[dict[str, Any]]) -> bool:
+    """Whether a quantity's values over the study are all positive and span more than `DECADES` decades (a fatigue
+    life): its OAT chart then shows log10(value / base), where a linear axis would hide all but the largest bar."""
+    values = [r[k] for r in rows for k in ("value_low", "value_high")] + [rows[0]["base"]]
+    values = [v for v in values if v is not None]
+    return bool(values) and min(values) > 0.0 and math.log10(max(values) / min(values)) > DECADES
+
+
+def _oat_row(
+    ax: Any, y: float, row: dict[str, Any], base: float | None, grey: bool, seen: set[str], decades: bool = False
+) -> None:
     for value, offset, color, label in ((row["value_low"], 0.17, _LOW, "parameter at its low value"),
                                         (row["value_high"], -0.17, _HIGH, "parameter at its high value")):
         if value is None or base is None:
             ax.text(0.0, y + offset, "  no value", va="center", fontsize="x-small")
             continue
         label = "below the numerical error" if grey else label
-        ax.barh(y + offset, value - base, height=0.32, color=_GREY if grey else color, label=_once(label, seen))
+        width = math.log10(value / base) if decades else value - base
+        ax.barh(y + offset, width, height=0.32, color=_GREY if grey else color, label=_once(label, seen))
 
 
 def _morris_row(ax: Any, y: float, row: dict[str, Any], grey: bool, seen: set[str]) -> None:
