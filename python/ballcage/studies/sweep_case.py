@@ -111,11 +111,15 @@ def run_case(task: CaseTask) -> dict[str, Any]:
 
 
 def _with_tables(task: CaseTask, scene: _native.Scene, kept: list[str] | None) -> _native.Scene:
-    """`scene`, recording also the tables the quantities plug-in reads (``memory_tables``) that it does not."""
+    """`scene`, recording also the tables the quantities plug-in reads (``memory_tables``) that it does not; `scene`
+    itself where they would not fit ``record.max_bytes`` (the quantities that need them are then null)."""
     extra = [t for t in getattr(task.quantities, "memory_tables", ()) if kept is not None and t not in kept]
     if not extra:
         return scene
-    return _native.Scene.from_toml(task.base_toml, [*task.overrides, f"record.tables={toml_value([*kept, *extra])}"])
+    try:
+        return _native.Scene.from_toml(task.base_toml, [*task.overrides, f"record.tables={toml_value([*kept, *extra])}"])
+    except _native.SceneError:
+        return scene
 
 
 def derive_case(task: CaseTask, source: dict[str, Any], run: Run | None) -> dict[str, Any]:
