@@ -4,8 +4,9 @@ Each parameter is a row, the largest effect at the top. One at a time (OAT):
 two bars from the base value, the change with the parameter at its low
 value and at its high value, in the quantity's unit (the top axis in per cent
 of the base), or in decades, log10(value / base), for a quantity whose
-values span more than two decades (a fatigue life: `spans_decades`). Morris: a bar of mu_star with its 95 % confidence interval and
-a diamond at sigma. The base run's numerical error is a row of its own (a
+values span more than two decades (a fatigue life: `spans_decades`).
+Morris: a bar of mu_star with its 95 % confidence interval and a diamond at
+sigma. The base run's numerical error is a row of its own (a
 hatched red bar) and a shaded band across every row: a parameter whose effect
 lies inside it is drawn grey and labelled "below the numerical error". A
 quantity without an error estimate says so above the chart, with the reason.
