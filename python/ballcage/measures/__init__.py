@@ -10,8 +10,9 @@ key-force peak's hinge, time and drive stage), `sections` (the internal loads
 at each link's neck, body and seat from a free-body cut of the rigid link),
 `fatigue` (their stress cycles and fatigue life: rainflow, Basquin–Goodman,
 Miner; ``fatigue.parquet``) and `quantities` (every quantity of a
-sweep case; `DRILL_PIPE`, the plug-in ``ballcage sweep``, ``ballcage chart``
-and ``ballcage paper --sweeps`` pass to `ballcage.sweep`). The paper's
+sweep case; `DRILL_PIPE`, the plug-in ``ballcage sweep`` and ``ballcage paper
+--sweeps`` pass to `ballcage.sweep`, and which ``ballcage chart``'s extends
+with the lives). The paper's
 comparison (`ballcage.paper`) takes its values from here and adds its notes.
 Above `ballcage.run` and `ballcage._links`; below `ballcage.studies` and
 `ballcage.paper`, which it never imports.

@@ -51,7 +51,7 @@ import pyarrow as pa
 
 from ballcage import _native, sizing
 from ballcage._files import write_parquet, write_png
-from ballcage.measures.quantities import DRILL_PIPE, QUANTITIES
+from ballcage.measures.quantities import QUANTITIES
 from ballcage.studies.design_chart_grid import (
     LENGTH,
     MASS,
@@ -64,6 +64,7 @@ from ballcage.studies.design_chart_grid import (
     chart_setup,
     chart_spec,
 )
+from ballcage.studies.sweep_quantities import DRILL_PIPE_LIVES, LIVES, LIVES_SECONDS_PER_SIMULATED_SECOND
 from ballcage.studies.sweep_run import SweepResult, pending_cases, sweep
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
@@ -98,6 +99,8 @@ QUANTITY_COLUMNS: tuple[str, ...] = (
     "tube_normal_mean_all_n",
     "tube_normal_peak_max_n",
     "efficiency",
+    "fatigue_life_min_h",
+    "wear_hours_min_h",
     "wall_time_s",
     "case_wall_time_s",
 )
@@ -167,7 +170,8 @@ def design_chart(
         estimate = _estimate(pending, setup, workers, client)
         if say:
             say(_plan(cells, pending, estimate, setup))
-        result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress, quantities=DRILL_PIPE)
+        result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress,
+                       quantities=DRILL_PIPE_LIVES)  # fmt: skip
     elif say:
         say(_plan(cells, 0, None, setup))
     folder.mkdir(parents=True, exist_ok=True)
@@ -183,8 +187,14 @@ def _estimate(pending: int, setup: Setup, workers: int | None, client: Any) -> f
         parallel = max(1, len(info.get("workers", {})))
     else:
         parallel = workers or os.cpu_count() or 1
-    per_case = SECONDS_PER_SIMULATED_SECOND.get(str(setup.fixed["pipe.hinge"]), 10.0) * setup.fixed["simulation.duration"]
+    per_case = _rate(setup) * setup.fixed["simulation.duration"]
     return math.ceil(pending / max(1, min(parallel, pending or 1))) * per_case
+
+
+def _rate(setup: Setup) -> float:
+    """Seconds of one core per simulated second of a cell: its run and its lives."""
+    hinge = str(setup.fixed["pipe.hinge"])
+    return SECONDS_PER_SIMULATED_SECOND.get(hinge, 10.0) + LIVES_SECONDS_PER_SIMULATED_SECOND.get(hinge, 1.0)
 
 
 def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: Setup) -> str:
@@ -198,11 +208,10 @@ def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: Setup)
     line = f"design chart: {len(cells)} cells, {feasible} feasible, {len(cells) - feasible} excluded ({why})"
     if estimate is None:
         return line + "; nothing to run"
-    rate = SECONDS_PER_SIMULATED_SECOND.get(str(setup.fixed["pipe.hinge"]), 10.0)
     return (
         f"{line}; {pending} to run, {feasible - pending} already finished: about {_duration(estimate)} "
-        f"({setup.fixed['pipe.hinge']}, {setup.fixed['simulation.duration']:g} s each at ~{rate:g} s per simulated s "
-        "on one core of a 2-core AMD EPYC; a rough guide, cells differ by up to 5x)"
+        f"({setup.fixed['pipe.hinge']}, {setup.fixed['simulation.duration']:g} s each at ~{_rate(setup):g} s per "
+        "simulated s on one core of a 2-core AMD EPYC, the lives included; a rough guide, cells differ by up to 5x)"
     )
 
 
@@ -282,6 +291,7 @@ def _columns() -> dict[str, tuple[pa.DataType, str, str]]:
     }
     units = {name: (unit, description) for name, _, unit, description in COST_COLUMNS}
     units.update(QUANTITIES)
+    units.update(LIVES)
     for name in QUANTITY_COLUMNS:
         unit, description = units[name]
         columns[name] = (f64, unit, description + " (null when infeasible or not computed)")

@@ -5,10 +5,10 @@
   forces, the drive efficiency, the per-link tube forces) and the smallest
   contact-pressure margin, ``pressure_margin_min`` (`ballcage.duty.smallest_margin`
   of the ``wear`` table: allowable over Hertz peak pressure, over the
-  contact pairs); the shortest fatigue life and wear life, `LIVES`
-  (``fatigue_life_min_h``, ``wear_hours_min_h``: `lives`), from every frame's
-  contacts, which each run records for them and the study does not keep
-  (``memory_tables``).
+  contact pairs); the shortest fatigue life and wear life,
+  `ballcage.studies.sweep_quantities.LIVES` (``fatigue_life_min_h``,
+  ``wear_hours_min_h``), from every frame's contacts, which each run records
+  for them and the study does not keep (``memory_tables``).
 - Scenes of bodies, `BODIES_SENSITIVITY`: each contact pair's summary
   statistics, ``<column>[<pair>]`` in N (`SUMMARY_STATISTICS`), and its
   largest penetration over the summary window, ``depth_peak[<pair>]`` in m
@@ -24,10 +24,15 @@ import re
 from collections.abc import Collection
 from typing import TYPE_CHECKING
 
-from ballcage._native import InputError
 from ballcage.duty import smallest_margin
 from ballcage.measures.quantities import DRILL_PIPE
-from ballcage.studies.sweep_quantities import SUMMARY_STATISTICS, SweepQuantities
+from ballcage.studies.sweep_quantities import (
+    LIVES,
+    SUMMARY_STATISTICS,
+    DrillPipeLives,
+    SweepQuantities,
+    lives,
+)
 from ballcage.studies.sweep_spec import DEFAULT_TABLES
 
 if TYPE_CHECKING:
@@ -35,8 +40,8 @@ if TYPE_CHECKING:
     from ballcage.run import Run
 
 __all__ = [
-    "BODIES_SENSITIVITY", "DRILL_PIPE_SENSITIVITY", "LIVES", "LIVES_SECONDS_PER_SIMULATED_SECOND", "PRESSURE_MARGIN",
-    "BodiesSensitivity", "DrillPipeSensitivity", "depth_peaks", "for_scene", "lives", "tables_for",
+    "BODIES_SENSITIVITY", "DRILL_PIPE_SENSITIVITY", "PRESSURE_MARGIN", "BodiesSensitivity", "DrillPipeSensitivity",
+    "depth_peaks", "for_scene", "tables_for",
 ]
 
 #: The smallest contact-pressure margin: name -> (unit, meaning).
@@ -50,35 +55,9 @@ PRESSURE_MARGIN: dict[str, tuple[str, str]] = {
 }
 
 
-#: The shortest fatigue life and wear life: name -> (unit, meaning).
-LIVES: dict[str, tuple[str, str]] = {
-    "fatigue_life_min_h": (
-        "h",
-        "shortest fatigue life of any link section (neck, body, seat) in hours of this duty: Basquin-Goodman and "
-        "Miner over the steady window (ballcage.measures.fatigue, fatigue.*); null for an ideal-CV hinge, a run too "
-        "short for a steady window, or no damage",
-    ),
-    "wear_hours_min_h": (
-        "h",
-        "hours of this duty until the wear map's deepest cell reaches wear.map_depth (Archard k/H over the frames, "
-        "ballcage.measures.wear_map, wear.*); null where nothing wears",
-    ),
-}
-
-
-#: Seconds of one core per simulated second the lives take (fatigue 0.73 s and wear map 0.79 s for the paper's 1.8 s;
-#: the ideal-CV hinge has the wear map only, 0.50 s; this project's machine, 2026-11-26), for a study's estimate.
-LIVES_SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 0.85, "ideal-cv": 0.3}
-
-
-class DrillPipeSensitivity:
-    """The drill pipe's sensitivity quantities: `DRILL_PIPE`'s, `PRESSURE_MARGIN` and `LIVES`.
-
-    The lives need every frame's contacts: each run records ``memory_tables`` for them, which a study does not keep.
-    """
-
-    #: Tables each run records for the lives and the study does not keep (`ballcage.studies.sweep_case.run_case`).
-    memory_tables: tuple[str, ...] = ("bodies", "contacts", "pairs")
+class DrillPipeSensitivity(DrillPipeLives):
+    """The drill pipe's sensitivity quantities: `DRILL_PIPE_LIVES`'s (`DRILL_PIPE`'s and `LIVES`) and
+    `PRESSURE_MARGIN`."""
 
     def columns(self, recorded: Collection[str]) -> dict[str, tuple[str, str]]:
         return DRILL_PIPE.columns(recorded) | PRESSURE_MARGIN | LIVES
@@ -97,26 +76,6 @@ class DrillPipeSensitivity:
 
 
 DRILL_PIPE_SENSITIVITY = DrillPipeSensitivity()
-
-
-def lives(run: Run) -> dict[str, float | None]:
-    """`LIVES` of a drill-pipe run: ``None`` where the run cannot give one (`InputError`: an ideal-CV hinge, a
-    table not recorded, a run too short for its steady window)."""
-    from ballcage.measures.fatigue import fatigue_table  # deferred: only studies that measure lives pay for them
-    from ballcage.measures.wear_map import deepest, wear_map
-
-    out: dict[str, float | None] = dict.fromkeys(LIVES)
-    try:
-        hours = [h for h in fatigue_table(run).column("hours_to_failure").to_pylist() if h is not None]
-        out["fatigue_life_min_h"] = min(hours) if hours else None
-    except InputError:
-        pass
-    try:
-        row = deepest(wear_map(run))
-        out["wear_hours_min_h"] = float(row["hours_to_depth"]) if row is not None else None
-    except InputError:
-        pass
-    return out
 
 
 #: The name of a contact pair's largest penetration: ``depth_peak[<contact pair>]``.

@@ -75,8 +75,9 @@ from ballcage.studies.sensitivity_design import (
 )
 from ballcage.studies.sensitivity_effects import sensitivity_table
 from ballcage.studies.sensitivity_parameters import ParameterChoice, parameter_ranges
-from ballcage.studies.sensitivity_quantities import LIVES_SECONDS_PER_SIMULATED_SECOND, for_scene, tables_for
+from ballcage.studies.sensitivity_quantities import for_scene, tables_for
 from ballcage.studies.sweep_case import PART, read_record, table_path
+from ballcage.studies.sweep_quantities import LIVES_SECONDS_PER_SIMULATED_SECOND
 from ballcage.studies.sweep_run import SweepResult, checked_case_timeout, pending_work, shared_runs, sweep
 from ballcage.studies.sweep_spec import SweepError, SweepSpec, partition_name
 

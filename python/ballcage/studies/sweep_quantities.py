@@ -12,7 +12,11 @@ quantities:
   scene for ``ballcage run --verify`` and ``ballcage sensitivity``;
 - `ballcage.measures.DRILL_PIPE` (drill pipes): included angles, ranges of
   motion, tube, cage and key forces, drive efficiency, per-link tube forces;
-  ``ballcage sweep``, ``ballcage chart`` and ``ballcage paper --sweeps`` pass it.
+  ``ballcage sweep`` and ``ballcage paper --sweeps`` pass it;
+- `DRILL_PIPE_LIVES` (drill pipes): those and the shortest fatigue and wear
+  lives (`LIVES`, `lives`), from every frame's contacts, which each run
+  records for them and the sweep does not keep (``memory_tables``);
+  ``ballcage chart`` passes it, and the sensitivity study's plug-in extends it.
 
 `for_scene` picks one of these by the scene's kind when a caller passes none.
 """
@@ -23,6 +27,7 @@ import re
 from collections.abc import Collection
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
+from ballcage._native import InputError
 from ballcage.measures.quantities import DRILL_PIPE
 
 if TYPE_CHECKING:
@@ -30,12 +35,17 @@ if TYPE_CHECKING:
     from ballcage.run import Run
 
 __all__ = [
+    "DRILL_PIPE_LIVES",
     "GENERIC",
+    "LIVES",
+    "LIVES_SECONDS_PER_SIMULATED_SECOND",
     "SUMMARY_STATISTICS",
+    "DrillPipeLives",
     "GenericQuantities",
     "SummaryStatistics",
     "SweepQuantities",
     "for_scene",
+    "lives",
     "summary_statistics",
 ]
 
@@ -117,6 +127,69 @@ class SummaryStatistics:
 
 
 SUMMARY_STATISTICS = SummaryStatistics()
+
+
+#: The shortest fatigue life and wear life: name -> (unit, meaning).
+LIVES: dict[str, tuple[str, str]] = {
+    "fatigue_life_min_h": (
+        "h",
+        "shortest fatigue life of any link section (neck, body, seat) in hours of this duty: Basquin-Goodman and "
+        "Miner over the steady window (ballcage.measures.fatigue, fatigue.*); null for an ideal-CV hinge, a run too "
+        "short for a steady window, or no damage",
+    ),
+    "wear_hours_min_h": (
+        "h",
+        "hours of this duty until the wear map's deepest cell reaches wear.map_depth (Archard k/H over the frames, "
+        "ballcage.measures.wear_map, wear.*); null where nothing wears",
+    ),
+}
+
+#: Seconds of one core per simulated second the lives take (fatigue 0.73 s and wear map 0.79 s for the paper's 1.8 s;
+#: the ideal-CV hinge has the wear map only, 0.50 s; this project's machine, 2026-11-26), for the estimates.
+LIVES_SECONDS_PER_SIMULATED_SECOND: dict[str, float] = {"ball-keys": 0.85, "ideal-cv": 0.3}
+
+
+def lives(run: Run) -> dict[str, float | None]:
+    """`LIVES` of a drill-pipe run: ``None`` where the run cannot give one (`InputError`: an ideal-CV hinge, a
+    table not recorded, a run too short for its steady window)."""
+    from ballcage.measures.fatigue import fatigue_table  # deferred: only plug-ins that measure lives pay for them
+    from ballcage.measures.wear_map import deepest, wear_map
+
+    out: dict[str, float | None] = dict.fromkeys(LIVES)
+    try:
+        hours = [h for h in fatigue_table(run).column("hours_to_failure").to_pylist() if h is not None]
+        out["fatigue_life_min_h"] = min(hours) if hours else None
+    except InputError:
+        pass
+    try:
+        row = deepest(wear_map(run))
+        out["wear_hours_min_h"] = float(row["hours_to_depth"]) if row is not None else None
+    except InputError:
+        pass
+    return out
+
+
+class DrillPipeLives:
+    """A drill pipe's `DRILL_PIPE` quantities and its `LIVES`.
+
+    The lives need every frame's contacts: each run records ``memory_tables`` for them, which a sweep does not keep.
+    """
+
+    #: Tables each run records for the lives and the sweep does not keep (`ballcage.studies.sweep_case.run_case`).
+    memory_tables: tuple[str, ...] = ("bodies", "contacts", "pairs")
+
+    def columns(self, recorded: Collection[str]) -> dict[str, tuple[str, str]]:
+        return DRILL_PIPE.columns(recorded) | LIVES
+
+    def __call__(self, run: Run) -> dict[str, float | None]:
+        out = DRILL_PIPE(run)
+        return out | lives(run) if out else out
+
+    def __repr__(self) -> str:
+        return "ballcage.studies.sweep_quantities.DRILL_PIPE_LIVES"
+
+
+DRILL_PIPE_LIVES = DrillPipeLives()
 
 
 def for_scene(scene: _native.Scene) -> SweepQuantities:
