@@ -132,6 +132,11 @@ def test_the_chart_files(chart: DesignChart) -> None:
     assert table.schema.field("tube_normal_mean_max_n").metadata[b"unit"] == b"N"
     assert table.schema.metadata[b"ballcage.chart_hinge"] == b"ideal-cv"
     assert table.column("key_peak_n").null_count == 6  # the ideal-CV model has no keys
+    # The lives: the ideal-CV hinge's joint loads are no contacts, so no fatigue life; the links wear on the tube.
+    assert table.schema.field("fatigue_life_min_h").metadata[b"unit"] == b"h"
+    assert table.column("fatigue_life_min_h").null_count == 6
+    ran = [r for r in table.to_pylist() if r["status"] == "ok"]
+    assert ran and all(r["wear_hours_min_h"] is not None and r["wear_hours_min_h"] > 0.0 for r in ran)
 
 
 def test_a_setting_the_chart_owns_is_refused() -> None:
