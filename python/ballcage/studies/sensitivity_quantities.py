@@ -31,7 +31,6 @@ from ballcage.studies.sweep_quantities import (
     SUMMARY_STATISTICS,
     DrillPipeLives,
     SweepQuantities,
-    lives,
 )
 from ballcage.studies.sweep_spec import DEFAULT_TABLES
 
@@ -63,13 +62,13 @@ class DrillPipeSensitivity(DrillPipeLives):
         return DRILL_PIPE.columns(recorded) | PRESSURE_MARGIN | LIVES
 
     def __call__(self, run: Run) -> dict[str, float | None]:
-        out = DRILL_PIPE(run)
+        out = super().__call__(run)
         if not out:  # not a drill pipe
             return out
         wear = run.tables.get("wear")
         row = smallest_margin(wear) if wear is not None else None
         out["pressure_margin_min"] = float(row["pressure_margin"]) if row is not None else None
-        return out | lives(run)
+        return out
 
     def __repr__(self) -> str:
         return "ballcage.studies.sensitivity_quantities.DRILL_PIPE_SENSITIVITY"

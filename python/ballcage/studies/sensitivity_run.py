@@ -169,12 +169,12 @@ def sensitivity(
     spec.check()
     runs = folder / RUNS
     per_run = _per_run(base, runs)
-    estimate = _estimate(per_run, design, runs, pending_work(spec, runs), workers, client,
+    run_of = shared_runs(spec, spec.cases())
+    estimate = _estimate(per_run, design, runs, pending_work(spec, runs, run_of), workers, client,
                          _lives_rate(base) * base.duration)  # fmt: skip
     if case_timeout == "auto":
         limit = _default_case_timeout(per_run[0], design)
     say: Callable[[str], None] = _say if progress is not False else (lambda _: None)
-    run_of = shared_runs(spec, spec.cases())
     say(_plan(base, design, estimate, limit, case_timeout == "auto", sum(1 for k, v in run_of.items() if k != v)))
     quantities = for_scene(base)
     result = sweep(spec, runs, client=client, workers=workers, plots=False, progress=progress, quantities=quantities,

@@ -178,13 +178,16 @@ def pending_cases(spec: SweepSource, out: str | os.PathLike[str]) -> int:
     return pending_work(spec, out)[0]
 
 
-def pending_work(spec: SweepSource, out: str | os.PathLike[str]) -> tuple[int, int]:
+def pending_work(
+    spec: SweepSource, out: str | os.PathLike[str], run_of: dict[int, int] | None = None
+) -> tuple[int, int]:
     """What the sweep `spec` has still to do in the folder `out`: the runs, and the cases computed from them that
-    share their run (`shared_runs`; no simulation, only their quantities)."""
+    share their run (`run_of`, `shared_runs` when not given; no simulation, only their quantities)."""
     loaded = load_sweep(spec)
     folder = Path(out)
     cases = loaded.cases()
-    pending, _ = _pending_runs([_task(loaded, c, folder) for c in cases], shared_runs(loaded, cases), folder, False)
+    run_of = shared_runs(loaded, cases) if run_of is None else run_of
+    pending, _ = _pending_runs([_task(loaded, c, folder) for c in cases], run_of, folder, False)
     return len(pending), sum(len(t.shares) for t in pending)
 
 
