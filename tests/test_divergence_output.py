@@ -227,3 +227,56 @@ def test_a_step_that_halving_did_not_cure_is_not_blamed_on_the_step():
     assert "simulation.newton.max_iterations" in text
     assert _advised_step(text) is None, text
 
+
+
+def sinking_ball(rtol: float) -> ballcage.SceneBuilder:
+    """A ball of 1 kg on a linear spring floor of 400 N/m under gravity: it settles 24.5 mm deep
+    (mg/k), beyond its pair's limit (25 % of the 50 mm radius, 12.5 mm), however accurately the
+    motion is integrated. Adaptive steps (ESDIRK3(2) at `rtol`)."""
+    return (
+        ballcage.SceneBuilder("sinking ball")
+        .simulation(duration=0.5, dt=1e-3, output_interval=1e-3, integrator="esdirk32", rtol=rtol)
+        .gravity([0.0, 0.0, -9.81])
+        .body("ground", motion="fixed", shape={"type": "half-space", "normal": [0.0, 0.0, 1.0]})
+        .body("ball", shape={"type": "ball", "radius": R}, mass=M, position=[0.0, 0.0, R])
+        .contact("ground", "ball", normal={"law": "linear", "stiffness": 400.0})
+    )
+
+
+def test_an_adaptive_run_that_sinks_says_its_steps_met_their_tolerance():
+    # The adaptive integrator shortened no step for this failure: the message must not claim it
+    # did, and says the depth is the model's, naming the tolerance the steps met.
+    with pytest.raises(ballcage.SimulationError) as info:
+        ballcage.simulate(sinking_ball(1e-4))
+    text = str(info.value)
+    assert "penetrates" in text and "every step met its error estimate's tolerance" in text, text
+    assert "simulation.rtol = 0.0001" in text and "the depth is the model's" in text, text
+    assert "went down to" not in text and _advised_step(text) is None, text
+    # It holds: a hundred times tighter, the run fails at the same frame (the depth crosses the
+    # limit at t ≈ 0.13 s; the 1 ms frames would show a step's worth of difference).
+    with pytest.raises(ballcage.SimulationError) as tighter:
+        ballcage.simulate(sinking_ball(1e-6))
+    assert _failure_time(str(tighter.value)) == _failure_time(text)
+
+
+def test_an_interpolated_frame_s_energy_does_not_stop_an_adaptive_run():
+    # Three ideal-CV links at rtol 1e-3 with steps of up to 5 ms and frames every 1 ms: the frame
+    # at 1 ms is interpolated within the first step, and the interpolant's velocities hold about
+    # ten times the kinetic energy the links have then (4.3e-5 J with 1 ms steps). That frame
+    # fails the energy balance; the integrator's own state at the step's end holds it, and the
+    # run goes on from there.
+    overrides = [
+        'pipe.hinge="ideal-cv"', "pipe.joints=3", "simulation.rtol=1e-3", "simulation.max_step=5e-3",
+        "simulation.duration=0.02", 'record.tables=["energy", "summary"]',
+    ]  # fmt: skip
+    run = ballcage.simulate(default_scene(overrides), progress=False)
+    assert run.complete
+    e = run.energy.to_pandas()
+    work = e["drive_work"] + e["load_work"]
+    created = e["total"] - e["total"].iloc[0] - work
+    free = e["kinetic"].iloc[0] + e["potential_contact"].iloc[0]
+    swing = (e["potential_gravity"] - e["potential_gravity"].iloc[0]).abs().cummax()
+    scale = free + swing + e["drive_work"].abs() + e["load_work"].abs()
+    at_1ms = e.index[np.isclose(e["t"], 1e-3)][0]
+    # The frame at 1 ms would have failed the check (energy_growth = 1): the test covers that path.
+    assert created[at_1ms] > 2.0 * scale[at_1ms], (created[at_1ms], scale[at_1ms])

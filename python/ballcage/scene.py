@@ -71,15 +71,21 @@ class SceneBuilder:
         output_interval: float | None = None,
         integrator: str | None = None,
         threads: int | None = None,
+        rtol: float | None = None,
+        max_step: float | None = None,
     ) -> Self:
         """Time stepping: `duration`, `dt` and `output_interval` [s], `integrator` name, and
-        `threads` evaluating the contact pairs (default 1; results are bitwise the same for any count)."""
+        `threads` evaluating the contact pairs (default 1; results are bitwise the same for any count).
+        With ``integrator="esdirk32"``, `rtol` [–] sets the adaptive steps' relative tolerance
+        (0: fixed steps of `dt`) and `max_step` [s] the longest step (default the output interval)."""
         given = {
             "duration": duration,
             "dt": dt,
             "output_interval": output_interval,
             "integrator": integrator,
             "threads": threads,
+            "rtol": rtol,
+            "max_step": max_step,
         }
         self._scene["simulation"].update({k: v for k, v in given.items() if v is not None})
         return self

@@ -231,6 +231,12 @@ impl Stages {
 }
 
 impl Implicit {
+    /// See [`super::super::Workspace::state_ahead_of_frame`].
+    pub(crate) fn state_ahead_of_frame(&self) -> Option<&State> {
+        let es = self.esdirk.as_ref()?;
+        es.ahead.as_ref().filter(|_| es.handed_valid)
+    }
+
     /// What ESDIRK3(2) has done so far (`None` for the other schemes).
     pub(crate) fn error_stats(&self) -> Option<ErrorStats> {
         self.esdirk.as_ref().map(|es| es.stats)

@@ -61,6 +61,15 @@ impl Workspace {
             .map_or_else(Stats::default, |w| w.stats)
     }
 
+    /// ESDIRK3(2)'s own state at the end of its last step, when the frame
+    /// it last handed out was interpolated within that step (`None` for the
+    /// other integrators, or when the frame was a step's end).
+    pub fn state_ahead_of_frame(&self) -> Option<&State> {
+        self.implicit
+            .as_ref()
+            .and_then(|w| w.state_ahead_of_frame())
+    }
+
     /// What ESDIRK3(2)'s steps and error estimate did so far (`None` for
     /// the other integrators, or before its first step).
     pub fn error_stats(&self) -> Option<ErrorStats> {
