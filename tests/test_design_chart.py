@@ -87,13 +87,39 @@ def test_a_cell_breaking_both_says_both(chart: DesignChart) -> None:
 
 
 def test_only_the_feasible_cells_ran_and_rerunning_resumes(chart: DesignChart) -> None:
+    # Each feasible cell and its verification run: 2 x 2 cases.
     assert chart.table.num_rows == 6 and chart.feasible == 2
-    assert chart.sweep is not None and chart.sweep.summary.num_rows == 2 and chart.sweep.ran == 2
+    assert chart.sweep is not None and chart.sweep.summary.num_rows == 4 and chart.sweep.ran == 4
     again = design_chart(
         chart.out, radii=[R_TIGHT, R_WIDE], lengths=[L_SHORT, L_IN, L_OUT], tube_inner_diameter=TUBE,
         joint_diameter=JOINT, hinge="ideal-cv", duration=DURATION, overrides=TINY, workers=2, progress=False,
     )
-    assert again.sweep is not None and (again.sweep.ran, again.sweep.skipped) == (0, 2)
+    assert again.sweep is not None and (again.sweep.ran, again.sweep.skipped) == (0, 4)
+
+
+def test_each_cell_s_numerical_error_is_its_difference_to_its_run_ten_times_tighter(chart: DesignChart) -> None:
+    # The verification cases are the feasible cells again at rtol/10 (the scene's 1e-4 over 10), after them.
+    assert chart.check is not None and chart.check.label == "rtol/10"
+    summary = pq.read_table(chart.out / "summary.parquet").to_pylist()
+    cells, checks = summary[:2], summary[2:]
+    assert [c["simulation.rtol"] for c in checks] == [1e-5, 1e-5]
+    assert [c["simulation.rtol"] for c in cells] == [1e-4, 1e-4]  # the scene's own
+    table = pq.read_table(chart.paths["table"])
+    assert table.schema.metadata[b"ballcage.chart_verification"] == b"rtol/10"
+    assert table.schema.field("tube_normal_mean_all_n_error").metadata[b"unit"] == b"N"
+    moved = 0
+    for cell, check in zip(cells, checks, strict=True):
+        assert (check["borehole.curvature_radius"], check["pipe.pitch"]) == (
+            cell["borehole.curvature_radius"], cell["pipe.pitch"])  # fmt: skip
+        row = _cell(chart, cell["borehole.curvature_radius"], cell["pipe.pitch"])
+        for name in ("tube_normal_mean_all_n", "tube_normal_mean_max_n", "wear_hours_min_h"):
+            assert row[name + "_error"] == abs(cell[name] - check[name]), name
+            moved += row[name + "_error"] > 0.0
+        # Ten times tighter moves the summed mean tube force by far less than the force itself: the chart's
+        # tolerance holds it to within a per cent even on these short runs.
+        assert row["tube_normal_mean_all_n_error"] < 0.01 * row["tube_normal_mean_all_n"]
+        assert row["key_peak_n_error"] is None  # no keys in the ideal-CV model
+    assert moved > 0  # the two runs differ: the error is measured, not zero by construction
 
 
 def test_the_mass_scaling_reproduces_the_paper_at_0_2_m_and_follows_the_formula() -> None:
@@ -167,4 +193,20 @@ def test_the_cli_estimates_runs_and_names_its_files(capsys: pytest.CaptureFixtur
     out, err = capsys.readouterr()
     assert code == 0
     assert "design chart: 2 cells, 1 feasible, 1 excluded (1 by articulation limit); 1 to run" in err
+    assert "each also at rtol/10 for its numerical error (1 of those to run" in err
     assert f"wrote {tmp_path / 'design_chart.png'}" in out and f"wrote {tmp_path / 'design_chart.parquet'}" in out
+    assert "largest numerical error (each cell against its run at rtol/10): tube_normal_mean_max_n 0 N (every value 0)" in out
+
+
+def test_no_verify_runs_each_cell_once_and_leaves_the_errors_null(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    args = ["chart", "--out", str(tmp_path), "--hinge", "ideal-cv", "--radius-mm", "1500", "--length-mm", "200",
+            "--duration", "0.02", "--workers", "1", "--no-verify", *[a for o in TINY for a in ("--set", o)]]
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    assert "not verified (no numerical error)" in err and "numerical error not measured (--no-verify)" in out
+    assert pq.read_table(tmp_path / "summary.parquet").num_rows == 1
+    table = pq.read_table(tmp_path / "design_chart.parquet")
+    assert table.column("tube_normal_mean_all_n_error").null_count == 1
+    assert table.column("tube_normal_mean_all_n").null_count == 0

@@ -50,6 +50,11 @@ def add(commands: Commands) -> None:
         "--window", metavar=("START", "END"), nargs=2, help="summary window of the tube forces [s] (default: the run's second half)"
     )
     chart.add_argument("--fixed-mass", action="store_true", help="keep the base link's mass and inertia at every length")
+    chart.add_argument(
+        "--no-verify", dest="verify", action="store_false",
+        help="skip the verification runs: by default each feasible cell runs again at ballcage run --verify's tighter "
+        "setting (rtol/10), and the chart gives each quantity's numerical error in that cell (about 3x the time)",
+    )
     chart.add_argument("--workers", metavar="N", type=workers, help="local threads running cells (default: one per CPU)")
     chart.add_argument("--scheduler", metavar="ADDRESS", help="run on the Dask cluster at ADDRESS; needs ballcage[dask]")
     add_set_option(chart, example="--set drive.speed_rpm=60 --set pipe.joints=8")
@@ -79,7 +84,7 @@ def _inputs(args: argparse.Namespace) -> dict[str, Any]:
         value = positive(option, text, "a positive length in mm")
         return None if value is None else value / 1e3
 
-    inputs: dict[str, Any] = {"hinge": args.hinge, "scale_mass": not args.fixed_mass}
+    inputs: dict[str, Any] = {"hinge": args.hinge, "scale_mass": not args.fixed_mass, "verify": args.verify}
     for option, key, texts in (("--radius-mm", "radii", args.radius_mm), ("--length-mm", "lengths", args.length_mm)):
         if texts is not None:
             inputs[key] = [metres(option, t) for t in texts]

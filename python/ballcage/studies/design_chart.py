@@ -16,9 +16,15 @@ A refused cell is infeasible; its reason names the constraints it breaks
 the validator's message. The feasible cells run as one sweep
 (`ballcage.studies.sweep_run.sweep`: local threads or Dask; running the same
 chart into the same folder resumes) with the hinge model, D, d, the duration
-and the summary window fixed. Written into ``out``::
+and the summary window fixed. With ``verify`` (the default) each feasible
+cell runs a second time at ``ballcage run --verify``'s tighter setting
+(`ballcage.studies.refinement.tighter`: ``rtol/10`` for the adaptive
+default), as a case of the same sweep, and each quantity's numerical error
+in that cell is |value − the value at the tighter setting|, in the
+quantity's unit (``<quantity>_error``). Written into ``out``::
 
-    design_chart.parquet   one row per cell: R, L, feasible, reason, the link's mass, the quantities
+    design_chart.parquet   one row per cell: R, L, feasible, reason, the link's mass, the quantities and their
+                           numerical errors
     design_chart.png       heat maps over R × L (`ballcage.studies.design_chart_plot`)
     summary.parquet, <table>/case=NNNN/part.parquet, cases/   the sweep's own files (docs/studies.md)
 
@@ -42,6 +48,7 @@ import math
 import os
 import sys
 import time
+import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -64,8 +71,10 @@ from ballcage.studies.design_chart_grid import (
     chart_setup,
     chart_spec,
 )
+from ballcage.studies.refinement import Tighter, cost_factor, tighter
 from ballcage.studies.sweep_quantities import DRILL_PIPE_LIVES, LIVES, LIVES_SECONDS_PER_SIMULATED_SECOND
 from ballcage.studies.sweep_run import SweepResult, pending_cases, sweep
+from ballcage.studies.sweep_spec import SweepSpec
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
 __all__ = [
@@ -104,6 +113,8 @@ QUANTITY_COLUMNS: tuple[str, ...] = (
     "wall_time_s",
     "case_wall_time_s",
 )
+#: The quantities whose numerical error the chart measures (``<name>_error``); the run times have none.
+CHECKED_COLUMNS: tuple[str, ...] = QUANTITY_COLUMNS[:-2]
 
 
 @dataclass
@@ -116,6 +127,7 @@ class DesignChart:
     sweep: SweepResult | None
     estimate_s: float | None  # the run time estimated before the sweep started [s]; None when nothing ran
     elapsed_s: float  # wall time of the whole chart [s]
+    check: Tighter | None = None  # the verification runs' setting; None without them
 
     @property
     def feasible(self) -> int:
@@ -141,6 +153,7 @@ def design_chart(
     workers: int | None = None,
     client: Any = None,
     progress: bool | None = None,
+    verify: bool = True,
 ) -> DesignChart:
     """Maps the forces of the paper's drill pipe over curvature radius × joint length into the folder `out`.
 
@@ -152,7 +165,8 @@ def design_chart(
     the run); `overrides` (``"key=value"``) change the embedded paper scene
     except the keys the chart sets. `scale_mass`: see the module docstring.
     `workers`, `client`, `progress`: as for `ballcage.studies.sweep_run.sweep`.
-    Writes ``design_chart.parquet`` and ``design_chart.png``; raises `ChartError`
+    `verify`: run each feasible cell again at the tighter setting for its
+    numerical error (see the module docstring). Writes ``design_chart.parquet`` and ``design_chart.png``; raises `ChartError`
     (a `SweepError`) for bad input, before anything runs.
     """
     start = time.perf_counter()
@@ -163,25 +177,46 @@ def design_chart(
     cells = chart_cells(setup, [float(r) for r in radii], [float(v) for v in lengths])
     feasible = [c for c in cells if c.feasible]
     say = (lambda text: print(f"ballcage: {text}", file=sys.stderr, flush=True)) if progress is not False else None
-    result, estimate = None, None
+    result, estimate, check = None, None, None
     if feasible:
-        spec = chart_spec(setup, [c.values for c in feasible])
-        pending = pending_cases(spec, folder)
-        estimate = _estimate(pending, setup, workers, client)
+        values = [c.values for c in feasible]
+        plain = chart_spec(setup, values)
+        check = _check(plain) if verify else None
+        spec = chart_spec(setup, values + [{**v, **_values(check)} for v in values]) if check else plain
+        pending = pending_cases(plain, folder)
+        checks = pending_cases(spec, folder) - pending if check else 0
+        estimate = _estimate(pending + (cost_factor(check) * checks if check else 0.0), setup, workers, client)
         if say:
-            say(_plan(cells, pending, estimate, setup))
+            say(_plan(cells, (pending, checks), estimate, setup, check))
         result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress,
                        quantities=DRILL_PIPE_LIVES)  # fmt: skip
     elif say:
-        say(_plan(cells, 0, None, setup))
+        say(_plan(cells, (0, 0), None, setup, None))
     folder.mkdir(parents=True, exist_ok=True)
-    table = chart_table(cells, result.summary if result is not None else None, setup)
+    table = chart_table(cells, result.summary if result is not None else None, setup, check)
     paths = _write(table, folder)
-    return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start)
+    return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start, check)
 
 
-def _estimate(pending: int, setup: Setup, workers: int | None, client: Any) -> float:
-    """Seconds the pending cases should take: rounds of `workers` cases at the measured cost per simulated second."""
+def _check(spec: SweepSpec) -> Tighter:
+    """The verification runs' setting: ``ballcage run --verify``'s for the chart's first cell (every cell shares the
+    time-stepping fields)."""
+    case = spec.cases()[0]
+    return tighter(_native.Scene.from_toml(spec.base_toml, list(case.overrides)))
+
+
+def _values(check: Tighter) -> dict[str, Any]:
+    """The overrides of `check` as a case's values (key -> TOML value)."""
+    values = {}
+    for override in check.overrides:
+        key, _, text = override.partition("=")
+        values[key] = tomllib.loads(f"v = {text}")["v"]
+    return values
+
+
+def _estimate(pending: float, setup: Setup, workers: int | None, client: Any) -> float:
+    """Seconds the pending cases should take: rounds of `workers` cases at the measured cost per simulated second;
+    `pending` counts a verification run as the cases it costs (`cost_factor`)."""
     if client is not None:
         info: dict[str, Any] = client.scheduler_info() if hasattr(client, "scheduler_info") else {}
         parallel = max(1, len(info.get("workers", {})))
@@ -197,8 +232,9 @@ def _rate(setup: Setup) -> float:
     return SECONDS_PER_SIMULATED_SECOND.get(hinge, 10.0) + LIVES_SECONDS_PER_SIMULATED_SECOND.get(hinge, 1.0)
 
 
-def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: Setup) -> str:
-    """The line printed before the chart runs: cells, why some are excluded, the estimate."""
+def _plan(cells: list[Cell], pending: tuple[int, int], estimate: float | None, setup: Setup, check: Tighter | None) -> str:
+    """The line printed before the chart runs: cells, why some are excluded, the estimate; `pending`: the cells and
+    the verification runs still to run."""
     excluded: dict[str, int] = {}
     for c in cells:
         if not c.feasible:
@@ -208,8 +244,15 @@ def _plan(cells: list[Cell], pending: int, estimate: float | None, setup: Setup)
     line = f"design chart: {len(cells)} cells, {feasible} feasible, {len(cells) - feasible} excluded ({why})"
     if estimate is None:
         return line + "; nothing to run"
+    cells_left, checks_left = pending
+    verified = (
+        f", each also at {check.label} for its numerical error ({checks_left} of those to run, each costing "
+        f"~{cost_factor(check):.2g} cells)"
+        if check is not None
+        else ", not verified (no numerical error)"
+    )
     return (
-        f"{line}; {pending} to run, {feasible - pending} already finished: about {_duration(estimate)} "
+        f"{line}; {cells_left} to run, {feasible - cells_left} already finished{verified}: about {_duration(estimate)} "
         f"({setup.fixed['pipe.hinge']}, {setup.fixed['simulation.duration']:g} s each at ~{_rate(setup):g} s per "
         "simulated s on one core of a 2-core AMD EPYC, the lives included; a rough guide, cells differ by up to 5x)"
     )
@@ -219,25 +262,39 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.0f} s" if seconds < 120 else f"{int(seconds // 60)} min {seconds % 60:.0f} s"
 
 
-def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup) -> pa.Table:
-    """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities.
+def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup, check: Tighter | None = None) -> pa.Table:
+    """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities and, with
+    `check` (the sweep then holds each feasible cell again at that setting, after all of them), their numerical errors.
 
     Units and descriptions in each field's metadata (and as JSON in the file's), like ``summary.parquet``.
     """
     rows = {r["case"]: r for r in summary.to_pylist()} if summary is not None else {}
+    feasible = sum(c.feasible for c in cells)
     records, index = [], 0
     for cell in cells:
-        row = None
-        if cell.feasible:  # the sweep's cases are the feasible cells, in order
-            row, index = rows.get(index), index + 1
-        records.append(_row(cell, row, setup))
-    if rows and len(rows) != sum(c.feasible for c in cells):
-        raise AssertionError("the sweep's cases are not the chart's feasible cells")
+        row, checked = None, None
+        if cell.feasible:  # the sweep's cases are the feasible cells, in order, then their verification runs
+            row, checked, index = rows.get(index), rows.get(feasible + index) if check else None, index + 1
+        records.append(_row(cell, row, setup) | _errors(row, checked))
+    if rows and len(rows) != feasible * (2 if check else 1):
+        raise AssertionError("the sweep's cases are not the chart's feasible cells (and their verification runs)")
     columns = _columns()
     fields = [pa.field(n, t, metadata={"unit": u, "description": d}) for n, (t, u, d) in columns.items()]
     arrays = [pa.array([r[n] for r in records], type=t) for n, (t, _, _) in columns.items()]
-    schema = pa.schema(fields).with_metadata(_file_metadata(fields, setup))
+    schema = pa.schema(fields).with_metadata(_file_metadata(fields, setup, check))
     return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def _errors(case: Mapping[str, Any] | None, checked: Mapping[str, Any] | None) -> dict[str, float | None]:
+    """Each checked quantity's numerical error, |value − value at the tighter setting|; None where either run did
+    not finish or has no value."""
+    out: dict[str, float | None] = {}
+    both = case is not None and checked is not None and case["status"] == "ok" and checked["status"] == "ok"
+    for name in CHECKED_COLUMNS:
+        a, b = (case.get(name), checked.get(name)) if both else (None, None)  # type: ignore[union-attr]
+        fine = isinstance(a, (int, float)) and isinstance(b, (int, float)) and math.isfinite(a) and math.isfinite(b)
+        out[name + "_error"] = abs(a - b) if fine else None  # type: ignore[operator]
+    return out
 
 
 def _row(cell: Cell, case: Mapping[str, Any] | None, setup: Setup) -> dict[str, Any]:
@@ -295,12 +352,19 @@ def _columns() -> dict[str, tuple[pa.DataType, str, str]]:
     for name in QUANTITY_COLUMNS:
         unit, description = units[name]
         columns[name] = (f64, unit, description + " (null when infeasible or not computed)")
+    for name in CHECKED_COLUMNS:
+        columns[name + "_error"] = (
+            f64, units[name][0],
+            f"numerical error of {name}: |value - the cell's value at the tighter setting of ballcage run --verify| "
+            "(ballcage.chart_verification; null when not verified, or either run did not finish)",
+        )
     return columns
 
 
-def _file_metadata(fields: list[pa.Field], setup: Setup) -> dict[str, str]:
+def _file_metadata(fields: list[pa.Field], setup: Setup, check: Tighter | None) -> dict[str, str]:
     window = setup.fixed["record.summary_window"]
     return {
+        "ballcage.chart_verification": check.label if check is not None else "",
         "ballcage.version": _native.__version__,
         "ballcage.chart_hinge": str(setup.fixed["pipe.hinge"]),
         "ballcage.chart_tube_inner_diameter_m": repr(setup.tube),
@@ -340,3 +404,22 @@ def describe(chart: DesignChart) -> Iterable[str]:
             f"ballcage: {chart.sweep.ran} cases run, {chart.sweep.skipped} skipped (already finished), "
             f"{chart.failed} not ok; {_duration(chart.elapsed_s)} in all{guess}"
         )
+        yield _error_line(chart)
+
+
+def _error_line(chart: DesignChart) -> str:
+    """The largest numerical error of each force panel's quantity over the cells, relative to the cell's value (or
+    absolute [N] where every value is 0), or why there is none."""
+    if chart.check is None:
+        return "ballcage: numerical error not measured (--no-verify)"
+    rows, parts = chart.table.to_pylist(), []
+    for name in ("key_peak_n", "tube_normal_mean_max_n", "tube_normal_mean_all_n", "tube_normal_peak_max_n"):
+        known = [r for r in rows if r[name + "_error"] is not None]
+        relative = [(r[name + "_error"] / abs(r[name]), r[RADIUS], r[LENGTH]) for r in known if r[name]]
+        if relative:
+            worst = max(relative)
+            parts.append(f"{name} {100 * worst[0]:.2g} % (R {worst[1]:g} m, L {worst[2]:g} m)")
+        elif known:
+            parts.append(f"{name} {max(r[name + '_error'] for r in known):.3g} N (every value 0)")
+    head = f"ballcage: largest numerical error (each cell against its run at {chart.check.label})"
+    return f"{head}: " + "; ".join(parts) if parts else f"{head}: no cell finished both runs"

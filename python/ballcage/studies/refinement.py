@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from ballcage import _native
 
-__all__ = ["TIGHTER", "Tighter", "tighter"]
+__all__ = ["TIGHTER", "Tighter", "cost_factor", "tighter"]
 
 #: A run's error bound falls by this factor in the verification run.
 TIGHTER = 10
@@ -62,3 +62,11 @@ def tighter(scene: _native.Scene) -> Tighter:
     order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
     d = math.ceil(TIGHTER ** (1.0 / order))
     return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
+
+
+def cost_factor(setting: Tighter) -> float:
+    """How many runs a verification run at `setting` costs: d for ``dt/d``; for ``rtol/10``, 10^(1/3), since
+    ESDIRK3(2)'s steps grow as the tolerance^(-1/3)."""
+    if setting.label.startswith("dt/"):
+        return float(setting.label.removeprefix("dt/"))
+    return TIGHTER ** (1.0 / 3.0)

@@ -60,7 +60,7 @@ from ballcage._files import write_parquet, write_text
 from ballcage._native import InputError
 from ballcage.scene import SceneSource, override_list
 from ballcage.studies.common import check_duration, resolve
-from ballcage.studies.refinement import TIGHTER, Tighter
+from ballcage.studies.refinement import cost_factor
 from ballcage.studies.schemas import SENSITIVITY_SCHEMA
 from ballcage.studies.sensitivity_design import (
     DEFAULT_LEVELS,
@@ -204,7 +204,7 @@ def _default_case_timeout(per_run: float | None, design: Design) -> float | None
     without an estimate."""
     if per_run is None:
         return None
-    longest = per_run * max(1.0, _check_weight(design.check) if design.check is not None else 1.0)
+    longest = per_run * max(1.0, cost_factor(design.check) if design.check is not None else 1.0)
     return max(TIMEOUT_FLOOR_S, TIMEOUT_FACTOR * longest)
 
 
@@ -251,20 +251,13 @@ def _estimate(
         parallel = max(1, len(info.get("workers", {})))
     else:
         parallel = workers or os.cpu_count() or 1
-    check = _check_weight(design.check) if design.check is not None and _pending(runs, len(design.roles) - 1) else 0.0
+    check = cost_factor(design.check) if design.check is not None and _pending(runs, len(design.roles) - 1) else 0.0
     work = pending - (1 if check else 0) + check
     seconds = per_run * max(math.ceil(work / parallel), check) if work > 0 else 0.0
     seconds += lives * shared  # in the worker of the run they share, one after another
     where = "on the Dask cluster" if client is not None else f"in {parallel} local threads"
     also = f" and {shared} cases from their runs" if shared else ""
     return seconds, f"{pending} runs to run{also} {where}, {basis}"
-
-
-def _check_weight(setting: Tighter) -> float:
-    """How many runs the verification costs: d for dt/d, 10^(1/3) for rtol/10 (ESDIRK3(2)'s steps grow as tol^-1/3)."""
-    if setting.label.startswith("dt/"):
-        return float(setting.label.removeprefix("dt/"))
-    return TIGHTER ** (1.0 / 3.0)
 
 
 def _pending(runs: Path, index: int) -> bool:
