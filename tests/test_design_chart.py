@@ -99,9 +99,10 @@ def test_only_the_feasible_cells_ran_and_rerunning_resumes(chart: DesignChart) -
 
 def test_each_cell_s_numerical_error_is_its_difference_to_its_run_ten_times_tighter(chart: DesignChart) -> None:
     # The verification cases are the feasible cells again at rtol/10 (the scene's 1e-4 over 10), after them.
-    assert chart.check is not None and chart.check.label == "rtol/10"
+    assert chart.verification == "rtol/10"
     summary = pq.read_table(chart.out / "summary.parquet").to_pylist()
     cells, checks = summary[:2], summary[2:]
+    assert [c["verifies"] for c in summary] == [None, None, 0, 1]
     assert [c["simulation.rtol"] for c in checks] == [1e-5, 1e-5]
     assert [c["simulation.rtol"] for c in cells] == [1e-4, 1e-4]  # the scene's own
     table = pq.read_table(chart.paths["table"])

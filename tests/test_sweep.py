@@ -22,7 +22,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import ballcage
-from ballcage.studies.sweep_spec import SweepError, load_sweep, toml_value
+from ballcage.studies.sweep_spec import SweepError, load_sweep, toml_value, with_verification
 from ballcage.studies.sweep_summary import WALL_TIME_COLUMNS, parameter_units
 
 REPO = Path(__file__).resolve().parent.parent
@@ -226,6 +226,42 @@ def test_resume_skips_finished_cases_and_reruns_missing_ones(
     assert (retried.ran, retried.skipped) == (1, 4)
 
 
+def test_verification_runs_follow_the_cases_and_give_each_quantity_s_numerical_error(
+    local: ballcage.studies.SweepResult, tmp_path: Path
+) -> None:
+    # The tiny sweep again with verification, into a copy of its folder: its 5 cases keep their hashes and are
+    # skipped, and each runs again at `ballcage run --verify`'s setting for its fixed steps: dt/3 for ESDIRK3(2)
+    # (order 3), dt/2 for RK4 (order 4).
+    out = tmp_path / "verified"
+    shutil.copytree(local.out, out)
+    spec = with_verification(SPEC)
+    assert (spec.verifies, spec.verification) == (5, "dt/3, dt/2")
+    result = ballcage.sweep(spec, out, workers=2, progress=False)
+    assert (result.ran, result.skipped) == (5, 5)
+    rows = result.summary.to_pylist()
+    assert [r["verifies"] for r in rows] == [None] * 5 + [0, 1, 2, 3, 4]
+    assert [r["simulation.dt"] for r in rows[5:]] == [1e-3 / 3] * 4 + [1e-3 / 2]
+    assert result.summary.schema.metadata[b"ballcage.sweep_verification"] == b"dt/3, dt/2"
+    # Every quantity's error is |value - its verification run's value| on the sweep's own rows; null on the
+    # verification rows and for the diverged RK4 case.
+    errors = [n for n in result.summary.column_names if n.endswith("_error")]
+    assert "tube_normal_mean_all_n_error" in errors
+    measured = 0
+    for name in errors:
+        quantity = name.removesuffix("_error")
+        assert result.summary.schema.field(name).metadata[b"unit"] == result.summary.schema.field(quantity).metadata[b"unit"]
+        for k in range(4):
+            a, b = rows[k][quantity], rows[k + 5][quantity]
+            assert rows[k][name] == (abs(a - b) if a is not None and b is not None else None), (name, k)
+            measured += bool(rows[k][name])
+        assert rows[4][name] is None and all(r[name] is None for r in rows[5:])
+    assert measured > 0  # the runs differ: the errors are measured, not zero by construction
+    # The plots stay those of the sweep's own cases against its own keys.
+    assert {p.stem for p in (out / "plots").glob("*.png")} == set(PARAMETERS)
+    assert "largest numerical errors (each case against its run at dt/3, dt/2)" in "\n".join(
+        ballcage.studies.sweep_run.describe(result))  # fmt: skip
+
+
 def test_a_folder_of_another_sweep_is_refused(local: ballcage.studies.SweepResult, tmp_path: Path) -> None:
     out = tmp_path / "copy"
     shutil.copytree(local.out, out)
@@ -250,6 +286,18 @@ def test_cli_runs_resumes_and_says_how_many_it_skipped(tmp_path: Path) -> None:
     assert "0 cases run, 5 skipped" in third.stdout
     zero = _cli("sweep", str(path), "--out", str(out), "--workers", "0")
     assert zero.returncode == 2 and "--workers: 0: must be at least 1" in zero.stderr, (zero.returncode, zero.stderr)
+
+
+def test_cli_verify_adds_the_verification_runs_and_names_the_largest_error(tmp_path: Path) -> None:
+    path = tmp_path / "tiny.toml"
+    path.write_text(TINY_TOML.split("[[case]]")[0])  # the grid's 4 cases, none diverging
+    out = tmp_path / "out"
+    done = _cli("sweep", str(path), "--out", str(out), "--workers", "2", "--no-plots", "--verify")
+    assert done.returncode == 0, done.stderr
+    assert "sweep tiny: 8 cases" in done.stderr
+    assert "largest numerical errors (each case against its run at dt/3): " in done.stdout
+    summary = pq.read_table(out / "summary.parquet")
+    assert summary.column("verifies").to_pylist() == [None] * 4 + [0, 1, 2, 3]
 
 
 def test_example_sweep_file_is_valid() -> None:

@@ -40,6 +40,12 @@ def add(commands: Commands) -> None:
     sweep.add_argument("--retry-failed", action="store_true", help="also run again the cases that diverged or failed")
     add_case_timeout_option(sweep, "default: none, a sweep having no estimate of its cases' time")
     sweep.add_argument("--no-plots", action="store_true", help="do not draw DIR/plots/*.png")
+    sweep.add_argument(
+        "--verify", action="store_true",
+        help="run every case again at ballcage run --verify's tighter setting (rtol/10 for adaptive steps, dt/d for "
+        "fixed ones), after all of them, and give each quantity's numerical error per case in summary.parquet "
+        "(<quantity>_error; about 3x the time)",
+    )
     add_quiet_option(sweep, "no progress and no summary lines")
     sweep.set_defaults(command=command)
 
@@ -57,11 +63,13 @@ def command(args: argparse.Namespace) -> int:
 
 def _sweep(args: argparse.Namespace, limit: float | None) -> int:
     from ballcage.studies.sweep_run import describe, scheduler_client, sweep
+    from ballcage.studies.sweep_spec import with_verification
 
+    source = with_verification(args.sweep) if args.verify else args.sweep
     try:
         with scheduler_client(args.scheduler) as client:
             result = sweep(
-                args.sweep,
+                source,
                 args.out,
                 client=client,
                 workers=args.workers,

@@ -48,7 +48,6 @@ import math
 import os
 import sys
 import time
-import tomllib
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -71,10 +70,10 @@ from ballcage.studies.design_chart_grid import (
     chart_setup,
     chart_spec,
 )
-from ballcage.studies.refinement import Tighter, cost_factor, tighter
+from ballcage.studies.refinement import cost_factor
 from ballcage.studies.sweep_quantities import DRILL_PIPE_LIVES, LIVES, LIVES_SECONDS_PER_SIMULATED_SECOND
 from ballcage.studies.sweep_run import SweepResult, pending_cases, sweep
-from ballcage.studies.sweep_spec import SweepSpec
+from ballcage.studies.sweep_spec import with_verification
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
 __all__ = [
@@ -127,7 +126,7 @@ class DesignChart:
     sweep: SweepResult | None
     estimate_s: float | None  # the run time estimated before the sweep started [s]; None when nothing ran
     elapsed_s: float  # wall time of the whole chart [s]
-    check: Tighter | None = None  # the verification runs' setting; None without them
+    verification: str = ""  # the verification runs' setting (``rtol/10``); empty without them
 
     @property
     def feasible(self) -> int:
@@ -177,41 +176,29 @@ def design_chart(
     cells = chart_cells(setup, [float(r) for r in radii], [float(v) for v in lengths])
     feasible = [c for c in cells if c.feasible]
     say = (lambda text: print(f"ballcage: {text}", file=sys.stderr, flush=True)) if progress is not False else None
-    result, estimate, check = None, None, None
+    result, estimate, verification = None, None, ""
     if feasible:
-        values = [c.values for c in feasible]
-        plain = chart_spec(setup, values)
-        check = _check(plain) if verify else None
-        spec = chart_spec(setup, values + [{**v, **_values(check)} for v in values]) if check else plain
+        plain = chart_spec(setup, [c.values for c in feasible])
+        spec = with_verification(plain) if verify else plain
+        verification = spec.verification
         pending = pending_cases(plain, folder)
-        checks = pending_cases(spec, folder) - pending if check else 0
-        estimate = _estimate(pending + (cost_factor(check) * checks if check else 0.0), setup, workers, client)
+        checks = pending_cases(spec, folder) - pending
+        estimate = _estimate(pending + _check_cost(verification) * checks, setup, workers, client)
         if say:
-            say(_plan(cells, (pending, checks), estimate, setup, check))
+            say(_plan(cells, (pending, checks), estimate, setup, verification))
         result = sweep(spec, folder, client=client, workers=workers, plots=False, progress=progress,
                        quantities=DRILL_PIPE_LIVES)  # fmt: skip
     elif say:
-        say(_plan(cells, (0, 0), None, setup, None))
+        say(_plan(cells, (0, 0), None, setup, ""))
     folder.mkdir(parents=True, exist_ok=True)
-    table = chart_table(cells, result.summary if result is not None else None, setup, check)
+    table = chart_table(cells, result.summary if result is not None else None, setup, verification)
     paths = _write(table, folder)
-    return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start, check)
+    return DesignChart(table, folder, paths, result, estimate, time.perf_counter() - start, verification)
 
 
-def _check(spec: SweepSpec) -> Tighter:
-    """The verification runs' setting: ``ballcage run --verify``'s for the chart's first cell (every cell shares the
-    time-stepping fields)."""
-    case = spec.cases()[0]
-    return tighter(_native.Scene.from_toml(spec.base_toml, list(case.overrides)))
-
-
-def _values(check: Tighter) -> dict[str, Any]:
-    """The overrides of `check` as a case's values (key -> TOML value)."""
-    values = {}
-    for override in check.overrides:
-        key, _, text = override.partition("=")
-        values[key] = tomllib.loads(f"v = {text}")["v"]
-    return values
+def _check_cost(verification: str) -> float:
+    """How many cells a verification run costs (`cost_factor`); 0 without verification runs."""
+    return cost_factor(verification) if verification else 0.0
 
 
 def _estimate(pending: float, setup: Setup, workers: int | None, client: Any) -> float:
@@ -232,7 +219,7 @@ def _rate(setup: Setup) -> float:
     return SECONDS_PER_SIMULATED_SECOND.get(hinge, 10.0) + LIVES_SECONDS_PER_SIMULATED_SECOND.get(hinge, 1.0)
 
 
-def _plan(cells: list[Cell], pending: tuple[int, int], estimate: float | None, setup: Setup, check: Tighter | None) -> str:
+def _plan(cells: list[Cell], pending: tuple[int, int], estimate: float | None, setup: Setup, verification: str) -> str:
     """The line printed before the chart runs: cells, why some are excluded, the estimate; `pending`: the cells and
     the verification runs still to run."""
     excluded: dict[str, int] = {}
@@ -246,9 +233,9 @@ def _plan(cells: list[Cell], pending: tuple[int, int], estimate: float | None, s
         return line + "; nothing to run"
     cells_left, checks_left = pending
     verified = (
-        f", each also at {check.label} for its numerical error ({checks_left} of those to run, each costing "
-        f"~{cost_factor(check):.2g} cells)"
-        if check is not None
+        f", each also at {verification} for its numerical error ({checks_left} of those to run, each costing "
+        f"~{_check_cost(verification):.2g} cells)"
+        if verification
         else ", not verified (no numerical error)"
     )
     return (
@@ -262,9 +249,9 @@ def _duration(seconds: float) -> str:
     return f"{seconds:.0f} s" if seconds < 120 else f"{int(seconds // 60)} min {seconds % 60:.0f} s"
 
 
-def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup, check: Tighter | None = None) -> pa.Table:
-    """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities and, with
-    `check` (the sweep then holds each feasible cell again at that setting, after all of them), their numerical errors.
+def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup, verification: str = "") -> pa.Table:
+    """One row per cell (L slowest, then R): geometry, feasibility, the link, the case, its quantities and, when the
+    sweep verified its cases (`with_verification`, at the setting `verification`), their numerical errors.
 
     Units and descriptions in each field's metadata (and as JSON in the file's), like ``summary.parquet``.
     """
@@ -272,29 +259,17 @@ def chart_table(cells: Sequence[Cell], summary: pa.Table | None, setup: Setup, c
     feasible = sum(c.feasible for c in cells)
     records, index = [], 0
     for cell in cells:
-        row, checked = None, None
+        row = None
         if cell.feasible:  # the sweep's cases are the feasible cells, in order, then their verification runs
-            row, checked, index = rows.get(index), rows.get(feasible + index) if check else None, index + 1
-        records.append(_row(cell, row, setup) | _errors(row, checked))
-    if rows and len(rows) != feasible * (2 if check else 1):
+            row, index = rows.get(index), index + 1
+        records.append(_row(cell, row, setup))
+    if rows and len(rows) != feasible * (2 if verification else 1):
         raise AssertionError("the sweep's cases are not the chart's feasible cells (and their verification runs)")
     columns = _columns()
     fields = [pa.field(n, t, metadata={"unit": u, "description": d}) for n, (t, u, d) in columns.items()]
     arrays = [pa.array([r[n] for r in records], type=t) for n, (t, _, _) in columns.items()]
-    schema = pa.schema(fields).with_metadata(_file_metadata(fields, setup, check))
+    schema = pa.schema(fields).with_metadata(_file_metadata(fields, setup, verification))
     return pa.Table.from_arrays(arrays, schema=schema)
-
-
-def _errors(case: Mapping[str, Any] | None, checked: Mapping[str, Any] | None) -> dict[str, float | None]:
-    """Each checked quantity's numerical error, |value − value at the tighter setting|; None where either run did
-    not finish or has no value."""
-    out: dict[str, float | None] = {}
-    both = case is not None and checked is not None and case["status"] == "ok" and checked["status"] == "ok"
-    for name in CHECKED_COLUMNS:
-        a, b = (case.get(name), checked.get(name)) if both else (None, None)  # type: ignore[union-attr]
-        fine = isinstance(a, (int, float)) and isinstance(b, (int, float)) and math.isfinite(a) and math.isfinite(b)
-        out[name + "_error"] = abs(a - b) if fine else None  # type: ignore[operator]
-    return out
 
 
 def _row(cell: Cell, case: Mapping[str, Any] | None, setup: Setup) -> dict[str, Any]:
@@ -323,6 +298,8 @@ def _row(cell: Cell, case: Mapping[str, Any] | None, setup: Setup) -> dict[str, 
     }
     for name in QUANTITY_COLUMNS:
         row[name] = None if case is None else case.get(name)
+    for name in CHECKED_COLUMNS:  # the summary's, when the sweep verified its cases
+        row[name + "_error"] = None if case is None else case.get(name + "_error")
     return row
 
 
@@ -361,10 +338,10 @@ def _columns() -> dict[str, tuple[pa.DataType, str, str]]:
     return columns
 
 
-def _file_metadata(fields: list[pa.Field], setup: Setup, check: Tighter | None) -> dict[str, str]:
+def _file_metadata(fields: list[pa.Field], setup: Setup, verification: str) -> dict[str, str]:
     window = setup.fixed["record.summary_window"]
     return {
-        "ballcage.chart_verification": check.label if check is not None else "",
+        "ballcage.chart_verification": verification,
         "ballcage.version": _native.__version__,
         "ballcage.chart_hinge": str(setup.fixed["pipe.hinge"]),
         "ballcage.chart_tube_inner_diameter_m": repr(setup.tube),
@@ -410,7 +387,7 @@ def describe(chart: DesignChart) -> Iterable[str]:
 def _error_line(chart: DesignChart) -> str:
     """The largest numerical error of each force panel's quantity over the cells, relative to the cell's value (or
     absolute [N] where every value is 0), or why there is none."""
-    if chart.check is None:
+    if not chart.verification:
         return "ballcage: numerical error not measured (--no-verify)"
     rows, parts = chart.table.to_pylist(), []
     for name in ("key_peak_n", "tube_normal_mean_max_n", "tube_normal_mean_all_n", "tube_normal_peak_max_n"):
@@ -421,5 +398,5 @@ def _error_line(chart: DesignChart) -> str:
             parts.append(f"{name} {100 * worst[0]:.2g} % (R {worst[1]:g} m, L {worst[2]:g} m)")
         elif known:
             parts.append(f"{name} {max(r[name + '_error'] for r in known):.3g} N (every value 0)")
-    head = f"ballcage: largest numerical error (each cell against its run at {chart.check.label})"
+    head = f"ballcage: largest numerical error (each cell against its run at {chart.verification})"
     return f"{head}: " + "; ".join(parts) if parts else f"{head}: no cell finished both runs"

@@ -204,7 +204,7 @@ def _default_case_timeout(per_run: float | None, design: Design) -> float | None
     without an estimate."""
     if per_run is None:
         return None
-    longest = per_run * max(1.0, cost_factor(design.check) if design.check is not None else 1.0)
+    longest = per_run * max(1.0, cost_factor(design.check.label) if design.check is not None else 1.0)
     return max(TIMEOUT_FLOOR_S, TIMEOUT_FACTOR * longest)
 
 
@@ -251,7 +251,8 @@ def _estimate(
         parallel = max(1, len(info.get("workers", {})))
     else:
         parallel = workers or os.cpu_count() or 1
-    check = cost_factor(design.check) if design.check is not None and _pending(runs, len(design.roles) - 1) else 0.0
+    pending_check = design.check is not None and _pending(runs, len(design.roles) - 1)
+    check = cost_factor(design.check.label) if pending_check and design.check is not None else 0.0
     work = pending - (1 if check else 0) + check
     seconds = per_run * max(math.ceil(work / parallel), check) if work > 0 else 0.0
     seconds += lives * shared  # in the worker of the run they share, one after another

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 import pyarrow as pa
+import pyarrow.compute as pc
 
 from ballcage import _native
 from ballcage._files import write_parquet
@@ -58,8 +59,8 @@ from ballcage.studies.sweep_spec import Case, SweepError, SweepSource, SweepSpec
 from ballcage.studies.sweep_summary import parameter_units, summary_table
 
 __all__ = [
-    "SweepResult", "checked_case_timeout", "connect", "pending_cases", "pending_work", "scheduler_client", "shared_runs",
-    "sweep",
+    "SweepResult", "checked_case_timeout", "connect", "largest_errors", "pending_cases", "pending_work",
+    "scheduler_client", "shared_runs", "sweep",
 ]
 
 
@@ -318,11 +319,17 @@ def _finish(
         "ballcage.sweep_parameters": json.dumps(spec.parameters),
         "ballcage.sweep_fixed": json.dumps(spec.fixed),
         "ballcage.sweep_base": str(spec.base) if spec.base is not None else "embedded paper scene",
+        "ballcage.sweep_verification": spec.verification,
     }
-    table = summary_table(records, spec.parameters, units, meta, quantities)
+    table = summary_table(records, spec.parameters, units, meta, quantities, spec.verifies)
     paths = {"summary": write_parquet(table, out / "summary.parquet")}
     if plots:
-        paths.update({f"plot_{k}": v for k, v in write_plots(table, spec.parameters, out).items()})
+        # The sweep's own cases against the swept keys, not the verification runs or their tighter setting.
+        own, swept = table, spec.parameters
+        if spec.verifies:
+            own = table.filter(pc.is_null(table.column("verifies")))
+            swept = list(dict.fromkeys(k for values in spec.listed[: spec.verifies] for k in values))
+        paths.update({f"plot_{k}": v for k, v in write_plots(own, swept, out).items()})
     failed = sum(1 for r in records if r.get("status") != "ok")
     return SweepResult(table, out, *counts, failed, paths)
 
@@ -389,6 +396,26 @@ def describe(result: SweepResult) -> Iterable[str]:
         f"ballcage: {result.ran} cases run{shared}, {result.skipped} skipped (already finished), "
         f"{result.failed} of {result.summary.num_rows} not ok"
     )
+    verification = (result.summary.schema.metadata or {}).get(b"ballcage.sweep_verification", b"").decode()
+    if verification:
+        worst = largest_errors(result.summary)[:3]
+        text = "; ".join(f"{name} {100 * rel:.2g} % (case {case})" for name, rel, case in worst) or "none measured"
+        yield f"ballcage: largest numerical errors (each case against its run at {verification}): {text}"
+
+
+def largest_errors(summary: pa.Table) -> list[tuple[str, float, int]]:
+    """Per quantity with a numerical error column, its largest error relative to the value and that case, largest
+    first; cases whose value is 0 are left out."""
+    rows, out = summary.to_pylist(), []
+    for name in summary.column_names:
+        if not name.endswith("_error") or name.removesuffix("_error") not in summary.column_names:
+            continue
+        quantity = name.removesuffix("_error")
+        relative = [(r[name] / abs(r[quantity]), r["case"]) for r in rows if r[name] is not None and r[quantity]]
+        if relative:
+            rel, case = max(relative)
+            out.append((quantity, rel, case))
+    return sorted(out, key=lambda x: -x[1])
 
 
 def connect(scheduler: str) -> Any:

@@ -32,7 +32,7 @@ import math
 import os
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import product
 from pathlib import Path
 from typing import Any, TypeAlias
@@ -40,7 +40,10 @@ from typing import Any, TypeAlias
 from ballcage import _native
 from ballcage.scene import default_scene_toml
 
-__all__ = ["DEFAULT_TABLES", "Case", "SweepError", "SweepSpec", "SweepSource", "load_sweep", "partition_name", "toml_value"]
+__all__ = [
+    "DEFAULT_TABLES", "Case", "SweepError", "SweepSpec", "SweepSource", "load_sweep", "partition_name", "toml_value",
+    "with_verification",
+]
 
 #: Tables a drill-pipe case records unless the sweep or its base scene says otherwise (no per-body tables).
 DEFAULT_TABLES: tuple[str, ...] = ("links", "hinges", "keys", "drive", "summary")
@@ -87,6 +90,10 @@ class SweepSpec:
     grid: dict[str, list[Any]] = field(default_factory=dict)
     listed: list[dict[str, Any]] = field(default_factory=list)
     source: str = "sweep"  # the file's path (or "sweep" for a dict), the prefix of error messages
+    #: `with_verification`: the last `verifies` cases are the first `verifies` again at the tighter setting of
+    #: ``ballcage run --verify`` (case k + verifies verifies case k); 0: no verification runs.
+    verifies: int = 0
+    verification: str = ""  # that setting's label(s), ``rtol/10``; empty without verification runs
 
     @property
     def parameters(self) -> list[str]:
@@ -156,6 +163,32 @@ def partition_name(index: int) -> str:
 
 
 SweepSource: TypeAlias = "str | os.PathLike[str] | Mapping[str, Any] | SweepSpec"
+
+
+def with_verification(source: SweepSource) -> SweepSpec:
+    """The sweep `source` with, after all its cases, each case again at the tighter setting of ``ballcage run
+    --verify`` (`ballcage.studies.refinement.tighter` of that case's scene: ``rtol/10`` for adaptive steps, ``dt/d``
+    for fixed ones): the summary then gives each quantity's numerical error in each case, |value − value at the
+    tighter setting| (`ballcage.studies.sweep_summary`). The cases keep their indices and hashes, so a sweep run
+    without verification resumes with it. Validates every case first (`SweepSpec.check`). Raises `SweepError`.
+    """
+    from ballcage.studies.refinement import tighter  # deferred: refinement is a study module
+
+    loaded = load_sweep(source)
+    if loaded.verifies:
+        return loaded
+    cases = loaded.check()
+    checks, labels = [], []
+    for case in cases:
+        setting = tighter(_native.Scene.from_toml(loaded.base_toml, list(case.overrides)))
+        values = {}
+        for override in setting.overrides:
+            key, _, text = override.partition("=")
+            values[key] = tomllib.loads(f"v = {text}")["v"]
+        checks.append({**case.values, **values})
+        labels += [setting.label] if setting.label not in labels else []
+    return replace(loaded, grid={}, listed=[dict(c.values) for c in cases] + checks, verifies=len(cases),
+                   verification=", ".join(labels))  # fmt: skip
 
 
 def load_sweep(source: SweepSource) -> SweepSpec:

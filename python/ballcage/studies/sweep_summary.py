@@ -1,8 +1,15 @@
-"""``summary.parquet``: one row per case, built from the cases' records; units in every field's metadata."""
+"""``summary.parquet``: one row per case, built from the cases' records; units in every field's metadata.
+
+A sweep with verification runs (`ballcage.studies.sweep_spec.with_verification`) also has, after the
+quantities, each quantity's numerical error in each case, ``<quantity>_error`` = |value − the value of its
+verification run| in the quantity's unit (null on the verification runs' own rows, and where either run did not
+finish or has no value), and before ``run_of`` the column ``verifies``: the case a verification run verifies.
+"""
 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -11,7 +18,7 @@ import pyarrow as pa
 from ballcage import _native
 from ballcage.studies.sweep_quantities import GENERIC, SweepQuantities
 
-__all__ = ["COST_COLUMNS", "RUN_OF_COLUMN", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
+__all__ = ["COST_COLUMNS", "RUN_OF_COLUMN", "VERIFIES_COLUMN", "WALL_TIME_COLUMNS", "parameter_units", "summary_table"]
 
 #: Columns that measure wall time: the only ones two runs of the same sweep may differ in.
 WALL_TIME_COLUMNS: tuple[str, ...] = ("wall_time_s", "case_wall_time_s")
@@ -30,6 +37,11 @@ COST_COLUMNS: tuple[tuple[str, pa.DataType, str, str], ...] = (
     ("wall_time_s", pa.float64(), "s", "wall time of the simulation alone (ballcage.wall_time_s); null for a case that "
      "shares another case's run (run_of)"),
     ("case_wall_time_s", pa.float64(), "s", "wall time of the whole case: scene, run, tables written, quantities"),
+)
+#: With verification runs, before ``run_of``: the case a row's run verifies (`with_verification`).
+VERIFIES_COLUMN: tuple[str, pa.DataType, str, str] = (
+    "verifies", pa.int32(), "", "the case this row verifies: it is that case again at the tighter setting of ballcage "
+    "run --verify (ballcage.sweep_verification); null for the sweep's own cases",
 )
 #: The last column: which case's run gave a case its tables (`ballcage.studies.sweep_run.shared_runs`).
 RUN_OF_COLUMN: tuple[str, pa.DataType, str, str] = (
@@ -61,8 +73,10 @@ def summary_table(
     units: Mapping[str, str],
     meta: Mapping[str, str],
     quantities: SweepQuantities = GENERIC,
+    verifies: int = 0,
 ) -> pa.Table:
-    """One row per record (sorted by case): head, swept parameters, the `quantities` plug-in's columns, cost."""
+    """One row per record (sorted by case): head, swept parameters, the `quantities` plug-in's columns, their
+    numerical errors when the last `verifies` cases verify the first ones (the module docstring), cost."""
     rows = sorted(records, key=lambda r: int(r["case"]))
     fields: list[pa.Field] = []
     arrays: list[pa.Array] = []
@@ -76,16 +90,38 @@ def summary_table(
         add(name, [r.get(name) for r in rows], kind, unit, description)
     for key in parameters:
         add(key, [r.get("parameters", {}).get(key) for r in rows], None, units.get(key, ""), f"scene key {key} (swept)")
-    for name, (unit, description) in _quantity_columns(rows, quantities).items():
+    columns = _quantity_columns(rows, quantities)
+    for name, (unit, description) in columns.items():
         add(name, [r.get("quantities", {}).get(name) for r in rows], pa.float64(), unit, description)
-    for name, kind, unit, description in (*COST_COLUMNS, RUN_OF_COLUMN):
+    if verifies:
+        checked = {int(r["case"]) - verifies: r for r in rows if int(r["case"]) >= verifies}
+        for name, (unit, _) in columns.items():
+            errors = [_error(r, checked.get(int(r["case"])), name) for r in rows]
+            add(f"{name}_error", errors, pa.float64(), unit,
+                f"numerical error of {name}: |value - the value of the case's verification run| (verifies)")
+    for name, kind, unit, description in COST_COLUMNS:
         add(name, [r.get(name) for r in rows], kind, unit, description)
+    if verifies:
+        name, kind, unit, description = VERIFIES_COLUMN
+        add(name, [int(r["case"]) - verifies if int(r["case"]) >= verifies else None for r in rows], kind, unit,
+            description)
+    name, kind, unit, description = RUN_OF_COLUMN
+    add(name, [r.get(name) for r in rows], kind, unit, description)
     schema = pa.schema(fields)
     file_meta = dict(meta)
     file_meta["ballcage.units"] = json.dumps({f.name: f.metadata[b"unit"].decode() for f in schema})
     file_meta["ballcage.descriptions"] = json.dumps({f.name: f.metadata[b"description"].decode() for f in schema})
     file_meta["ballcage.version"] = _native.__version__
     return pa.Table.from_arrays(arrays, schema=schema.with_metadata(file_meta))
+
+
+def _error(row: Mapping[str, Any], check: Mapping[str, Any] | None, name: str) -> float | None:
+    """|value − value of the verification run| of quantity `name` in `row`; None where there is none."""
+    if check is None or row.get("status") != "ok" or check.get("status") != "ok":
+        return None
+    a, b = row.get("quantities", {}).get(name), check.get("quantities", {}).get(name)
+    numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in (a, b))
+    return abs(a - b) if numbers else None
 
 
 def _quantity_columns(rows: Sequence[Mapping[str, Any]], quantities: SweepQuantities) -> dict[str, tuple[str, str]]:
