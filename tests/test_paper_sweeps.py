@@ -114,6 +114,25 @@ def test_trend_within_the_spread_is_flat_and_small_ratios_do_not_hold() -> None:
     assert "smallest 2" in table["normal_exceeds_tangential"]["verdict"]
 
 
+def test_a_change_within_twice_the_numerical_error_is_flat() -> None:
+    # The tube force over R falls 1200 N end to end against a spread of 3 N: it holds. With the cases verified, a
+    # numerical error of 700 N in one of them makes the tolerance 2 x 700 = 1400 N, and the same change is flat;
+    # 500 N (tolerance 1000 N) leaves it standing. Unverified rows (no _error column) weigh the spread alone.
+    for error, expected in ((700.0, "flat"), (500.0, "holds")):
+        rows = [dict(r, tube_normal_mean_max_n_error=1.0) for r in SWEEP_ROWS]
+        rows[2]["tube_normal_mean_max_n_error"] = error  # R 2.0 m, in the series
+        tube_r = {r["key"]: r for r in trend_table(_summary(rows)).to_pylist()}["tube_mean_max_falls_with_R"]
+        assert tube_r["numerical_error"] == error
+        assert tube_r["numerical_error_percent"] == pytest.approx(100.0 * error / 1300.0)
+        assert tube_r["verdict"] == expected, error
+    # An error in the spread's copies counts too (they are the baseline's cases).
+    rows = [dict(r, tube_normal_mean_max_n_error=1.0) for r in SWEEP_ROWS]
+    rows[7]["tube_normal_mean_max_n_error"] = 650.0
+    assert {r["key"]: r for r in trend_table(_summary(rows)).to_pylist()}["tube_mean_max_falls_with_R"]["verdict"] == "flat"
+    plain = {r["key"]: r for r in trend_table(_summary(SWEEP_ROWS)).to_pylist()}["tube_mean_max_falls_with_R"]
+    assert plain["numerical_error"] is None and plain["verdict"] == "holds"
+
+
 def test_missing_key_forces_are_not_checked_and_say_where() -> None:
     rows = [dict(r, key_peak_n=None) for r in SWEEP_ROWS]  # the ideal-CV model has no keys
     table = {r["key"]: r for r in trend_table(_summary(rows)).to_pylist()}
@@ -178,7 +197,9 @@ def swept(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Pat
 def test_run_paper_with_sweeps_writes_the_sweep_figures_and_trends(swept: tuple[Path, dict[str, Path]]) -> None:
     out, paths = swept
     summary = pq.read_table(out / "sweeps" / "summary.parquet")
-    assert summary.num_rows == 9 and set(summary.column("status").to_pylist()) == {"ok"}
+    # The 9 cases, then each again ten times tighter (run_paper verifies by default).
+    assert summary.num_rows == 18 and set(summary.column("status").to_pylist()) == {"ok"}
+    assert summary.column("verifies").to_pylist() == [None] * 9 + list(range(9))
     for name in ("fig16_curvature", "fig17_speed", "losses_curvature"):
         assert paths[name].read_bytes()[:8] == PNG_MAGIC
     trends = pq.read_table(paths["trends"])
@@ -187,6 +208,9 @@ def test_run_paper_with_sweeps_writes_the_sweep_figures_and_trends(swept: tuple[
         "key_peak_rises_with_rpm", "normal_exceeds_tangential",
     ]
     assert "## The paper's trends" in paths["comparison_md"].read_text(encoding="utf-8")
+    # Each trend over a series weighs its change against the cases' numerical error.
+    errors = trends.column("numerical_error").to_pylist()
+    assert all(e is not None and e >= 0.0 for e in errors[:4]) and errors[4] is None
 
 
 def test_sweep_rows_of_the_comparison_come_from_the_right_cases(swept: tuple[Path, dict[str, Path]]) -> None:
@@ -201,7 +225,8 @@ def test_sweep_rows_of_the_comparison_come_from_the_right_cases(swept: tuple[Pat
         assert rows[f"sweep_{vid}_key_peak_n"]["ours"] > 0, vid
     assert "of the R = 1.0 m variant" in rows["sweep_R1000_key_peak_n"]["note"]
     # the R = 1.0 m case's key peak is the summary's, not the baseline's
-    summary = {(r[RADIUS_KEY], r[RPM_KEY]): r for r in pq.read_table(out / "sweeps" / "summary.parquet").to_pylist()}
+    summary = {(r[RADIUS_KEY], r[RPM_KEY]): r for r in pq.read_table(out / "sweeps" / "summary.parquet").to_pylist()
+               if r["verifies"] is None}  # not the verification runs' rows, which repeat each case ten times tighter
     assert rows["sweep_R1000_key_peak_n"]["ours"] == pytest.approx(summary[(1.0, 100.0)]["key_peak_n"])
     assert rows["sweep_rpm120_key_peak_n"]["ours"] == pytest.approx(summary[(1.5, 120.0)]["key_peak_n"])
     assert summary[(1.0, 100.0)]["key_peak_n"] != pytest.approx(summary[(1.5, 100.0)]["key_peak_n"], rel=1e-3)

@@ -39,8 +39,9 @@ def add(commands: Commands) -> None:
         "--sweeps",
         action="store_true",
         help="also run the paper's section 4 as a sweep into DIR/sweeps (R = 1.0-2.5 m at 100 rpm, 60-120 rpm at "
-        "1.5 m, and the baseline with R +-1 um for the run-to-run spread: 9 runs, resumed when run again); fill the "
-        "sweep rows, draw Figures 16-17 and check the paper's trends (trends.parquet)",
+        "1.5 m, and the baseline with R +-1 um for the run-to-run spread: 9 runs, and unless --no-verify each again "
+        "ten times tighter for its numerical error; resumed when run again); fill the sweep rows, draw Figures 16-17 "
+        "and check the paper's trends against the spread and the numerical error (trends.parquet)",
     )
     paper.add_argument("--workers", metavar="N", type=workers, help="with --sweeps: local threads (default: one per CPU)")
     paper.add_argument(

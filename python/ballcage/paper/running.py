@@ -87,6 +87,7 @@ def run_paper(
     sweep's summary and its rows stay empty).
     """
     from ballcage.paper.section4 import section4_spec  # deferred: the sweep machinery imports this package
+    from ballcage.studies.sweep_spec import with_verification
 
     user = override_list(overrides)
     out = Path(out_dir)
@@ -96,6 +97,8 @@ def run_paper(
     spec = section4_spec(user) if sweeps else None
     if spec is not None:
         spec.check()
+        if verify:  # each case again ten times tighter: the trends weigh their changes against that error
+            spec = with_verification(spec)
     run, written, derived, failure = _run_and_write(main_scene, out, progress, verify)
     section4 = _run_section4(out, spec, written, client, workers, progress) if spec is not None else None
     sweep_runs = section4[0].variant_runs() if section4 is not None else None
@@ -108,7 +111,7 @@ def run_paper(
         command=_command_line(out, user, sweeps, sensitivity, verify),
         run=run,
         sweep_runs=sweep_runs,
-        section4=(section4[0].result.summary, section4[1]) if section4 is not None else None,
+        section4=(section4[0].summary, section4[1]) if section4 is not None else None,
         unverified=str(failure) if failure is not None else None if verify else "not measured (--no-verify)",
     )
     written["comparison_md"] = write_text(md + derived, out / "comparison.md")
@@ -164,7 +167,7 @@ def _run_section4(
     section4 = run_section4(out / "sweeps", spec, client=client, workers=workers, progress=progress)
     written["sweeps"] = out / "sweeps"
     written.update(write_section4_figures(section4.curvature_runs(), section4.speed_runs(), out))
-    trends = trend_table(section4.result.summary, section4.other_windows())
+    trends = trend_table(section4.summary, section4.other_windows())
     written["trends"] = write_parquet(trends, out / "trends.parquet")
     return section4, trends
 

@@ -1,7 +1,9 @@
 """The paper's §4.2–4.3 as one sweep (``ballcage paper --sweeps``), on the sweep machinery of `ballcage.sweep`.
 
 Each case records the drill pipe's quantities (`ballcage.measures.DRILL_PIPE`);
-none runs the paper's comparison.
+none runs the paper's comparison. Unless ``--no-verify``, every case runs
+again ten times tighter (`ballcage.studies.sweep_spec.with_verification`),
+and the trends weigh each change against that numerical error.
 
 The cases, on the paper scene with the user's overrides:
 
@@ -25,6 +27,9 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+import pyarrow as pa
+import pyarrow.compute as pc
 
 from ballcage import _native
 from ballcage._native import InputError
@@ -63,6 +68,15 @@ class Section4:
 
     result: SweepResult
     runs: dict[tuple[float, float], Run]
+
+    @property
+    def summary(self) -> pa.Table:
+        """The sweep's summary without its verification runs' rows (`with_verification`): one row per case, with
+        each quantity's numerical error when the sweep verified its cases."""
+        table = self.result.summary
+        if "verifies" not in table.column_names:
+            return table
+        return table.filter(pc.is_null(table.column("verifies")))
 
     def variant_runs(self) -> dict[str, Run]:
         """The runs of the reference file's sweep variants (`SWEEPS` ids) that finished."""
@@ -140,7 +154,7 @@ def run_section4(
     result = sweep(spec, out, client=client, workers=workers, progress=progress, quantities=DRILL_PIPE)
     runs: dict[tuple[float, float], Run] = {}
     for row in result.summary.to_pylist():
-        if row["status"] == "ok":
+        if row["status"] == "ok" and row.get("verifies") is None:
             runs[(float(row[RADIUS_KEY]), float(row[RPM_KEY]))] = read_case_run(Path(out), int(row["case"]))
     return Section4(result, runs)
 

@@ -1,16 +1,19 @@
 """The paper's ``[[trend]]`` claims checked on the section-4 sweep (`trend_table`, ``DIR/trends.parquet``).
 
 A claim "q falls (rises) as p grows" is checked on its series (§4.2 for the
-curvature radius, §4.3 for the speed), with the run-to-run spread beside it:
-the spread is the range (max − min) of q over the baseline and its two copies
-with R moved by ± 1 µm. The verdict:
+curvature radius, §4.3 for the speed), against a tolerance: the larger of
+the run-to-run spread, the range (max − min) of q over the baseline and its
+two copies with R moved by ± 1 µm, and twice the numerical error, the
+largest |q − q of the case's run ten times tighter| over those cases (when
+the sweep verified its cases: ``<q>_error``; a change of two values each
+off by up to that much). The verdict:
 
 - ``holds``: q changes end to end in the claimed direction by more than the
-  spread, and no step between neighbouring cases goes against it by more than
-  the spread;
+  tolerance, and no step between neighbouring cases goes against it by more
+  than the tolerance;
 - ``holds end to end, not monotone``: as above, but some step goes against it;
-- ``flat``: the end-to-end change is within the spread;
-- ``reversed``: q changes end to end against the claim by more than the spread;
+- ``flat``: the end-to-end change is within the tolerance;
+- ``reversed``: q changes end to end against the claim by more than the tolerance;
 - ``not checked: ...``: q is missing (a case did not finish, or the hinge model
   has no keys), or the reference file has a trend this module has no rule for.
 
@@ -54,8 +57,15 @@ TRENDS_SCHEMA = pa.schema(
         pa.field("spread", pa.float64(), metadata={"description": "run-to-run spread: max - min over the baseline and "
                                                    "its two copies with R moved by +-1 um", "unit": "see quantity"}),
         pa.field("spread_percent", pa.float64(), metadata={"description": "spread / baseline value", "unit": "%"}),
+        pa.field("numerical_error", pa.float64(), metadata={"description": "the largest numerical error of the quantity "
+                                                            "over the series and the spread's cases, |value - value "
+                                                            "ten times tighter|; null when not verified",
+                                                            "unit": "see quantity"}),
+        pa.field("numerical_error_percent", pa.float64(), metadata={"description": "numerical_error / baseline value",
+                                                                    "unit": "%"}),
         pa.field("verdict", pa.string(), metadata={"description": "holds, holds end to end (not monotone), flat, "
-                                                   "reversed, or not checked (why)"}),
+                                                   "reversed, or not checked (why), against the larger of the spread "
+                                                   "and twice the numerical error"}),
         pa.field("other_windows", pa.string(), metadata={"description": "the verdict with the quantities averaged "
                                                          "over other windows (label: verdict; null: none given)"}),
         pa.field("paper", pa.string(), metadata={"description": "the paper's own numbers for the claim"}),
@@ -125,6 +135,8 @@ def _series_trend(key: str, claim: str, rows: Sequence[Mapping[str, Any]], units
         return _row(key, claim, **base, verdict=f"not checked: {why}")
     spread_values = [float(r[quantity]) for r in spread_rows(rows) if r.get(quantity) is not None]
     spread = max(spread_values) - min(spread_values) if len(spread_values) >= 2 else 0.0
+    errors = [float(e) for r in (*series, *spread_rows(rows)) if (e := r.get(quantity + "_error")) is not None]
+    error = max(errors) if errors else None
     xs, ys = [p[0] for p in known], [p[1] for p in known]
     baseline = _baseline(known, parameter)
     change = ys[-1] - ys[0]
@@ -137,7 +149,9 @@ def _series_trend(key: str, claim: str, rows: Sequence[Mapping[str, Any]], units
         change_percent=100.0 * change / baseline if baseline else None,
         spread=spread,
         spread_percent=100.0 * spread / baseline if baseline else None,
-        verdict=verdict(xs, ys, direction, spread),
+        numerical_error=error,
+        numerical_error_percent=100.0 * error / baseline if baseline and error is not None else None,
+        verdict=verdict(xs, ys, direction, max(spread, 2.0 * error) if error is not None else spread),
     )
 
 
@@ -222,16 +236,20 @@ def trend_markdown(summary: pa.Table, table: pa.Table) -> list[str]:
         "",
         "## The paper's trends (`[[trend]]`), checked on the section-4 sweep",
         "",
-        "The spread is the range of the quantity over the baseline and two copies with R moved by ±1 µm; a change "
-        "within it is `flat`. `paper` is the same check on the paper's own numbers (its baseline and §4 values).",
+        "The spread is the range of the quantity over the baseline and two copies with R moved by ±1 µm; the "
+        "numerical error is its largest difference to the same case run ten times tighter (empty with --no-verify); "
+        "a change within the larger of the spread and twice the error is `flat`. The other windows' verdicts weigh "
+        "the spread only. `paper` is the same check on the paper's own numbers (its baseline and §4 values).",
         "",
-        "| trend | ours | change | spread | verdict | verdict over other windows | paper | paper's verdict |",
-        "| --- | --- | ---: | ---: | --- | --- | --- | --- |",
+        "| trend | ours | change | spread | numerical error | verdict | verdict over other windows | paper | "
+        "paper's verdict |",
+        "| --- | --- | ---: | ---: | ---: | --- | --- | --- | --- |",
     ]
     for r in table.to_pylist():
         change = "" if r["change_percent"] is None else f"{r['change_percent']:+.1f} %"
         spread = "" if r["spread_percent"] is None else f"{r['spread_percent']:.2g} %"
-        cells = [r["key"], r["ours"] or "", change, spread, r["verdict"], r["other_windows"] or "", r["paper"] or "",
-                 r["paper_verdict"] or ""]
+        error = "" if r["numerical_error_percent"] is None else f"{r['numerical_error_percent']:.2g} %"
+        cells = [r["key"], r["ours"] or "", change, spread, error, r["verdict"], r["other_windows"] or "",
+                 r["paper"] or "", r["paper_verdict"] or ""]
         lines.append("| " + " | ".join(str(c).replace("|", "\\|") for c in cells) + " |")
     return lines
