@@ -497,6 +497,8 @@ impl Implicit {
             return Ok(());
         }
         self.first_stage(model, dynamics, state, h);
+        // A rate measured in an earlier step (or attempt) is no longer this step's.
+        self.theta_step = None;
         let mut stage = self.stage.take().unwrap_or_else(|| state.clone());
         self.v.copy_from_slice(&self.v_n);
         if !model.newton.reuse_jacobian {
