@@ -663,17 +663,8 @@ impl Implicit {
                 self.theta_last = theta;
                 self.theta_step = Some(theta);
             }
-            // ESDIRK3(2) judges an iteration without a rate of its own (the
-            // first of a stage or of a Jacobian) by the last rate measured
-            // (Hairer & Wanner, Solving ODEs II, §IV.8, η): this step's, at
-            // least RATE_FLOOR_IN_STEP, else an earlier step's, at least
-            // RATE_FLOOR. SDIRK2 waits for a rate of its own.
-            let rate = theta.or((self.scheme == Scheme::Esdirk32).then(|| {
-                self.theta_step
-                    .map_or(self.theta_last.max(RATE_FLOOR), |t| {
-                        t.max(RATE_FLOOR_IN_STEP)
-                    })
-            }));
+            // SDIRK2 waits for a rate of its own.
+            let rate = theta.or((self.scheme == Scheme::Esdirk32).then(|| self.borrowed_rate()));
             previous = norm;
             if converged(norm, rate, self.scheme.newton_tolerance(model)) {
                 self.set_stage(model, start, stage, s, t_stage, h);
@@ -696,6 +687,18 @@ impl Implicit {
             last: previous,
             tolerance: settings.tolerance,
         })
+    }
+
+    /// The contraction rate ESDIRK3(2) judges an iteration without a rate
+    /// of its own (the first of a stage or of a Jacobian) by: the last rate
+    /// measured (Hairer & Wanner, Solving ODEs II, §IV.8, η), this step's at
+    /// least `RATE_FLOOR_IN_STEP`, else an earlier step's at least
+    /// `RATE_FLOOR`.
+    fn borrowed_rate(&self) -> f64 {
+        self.theta_step
+            .map_or(self.theta_last.max(RATE_FLOOR), |t| {
+                t.max(RATE_FLOOR_IN_STEP)
+            })
     }
 
     /// With a fresh Jacobian and adaptive steps: why the iterations of stage
