@@ -672,13 +672,13 @@ impl Simulation {
     /// integrator's own state at the step's end keeps the energy balance
     /// that the frame failed ([`Self::energy_created`], with the input work
     /// carried to the step's end at the frame's input power). The
-    /// interpolant's error is not controlled: within a step that passes
-    /// over a stiff contact's settling, its positions can miss the contact
-    /// surfaces by a micrometre, which holds more elastic energy than a
-    /// system at rest has (measured on the ideal-CV pipe at rtol 1e-3 and
-    /// steps of 5 ms: 4.6e-4 J at the 1 ms frame against an energy scale
-    /// of 3e-4 J). The run goes on from the step's end, so that is the
-    /// state a divergence would show in.
+    /// interpolant's error is not controlled: within a step over which a
+    /// stiff transient settles, its velocities, cubic Hermite from the
+    /// accelerations at the step's ends, overshoot (three ideal-CV links at
+    /// rtol 1e-3 with steps of up to 5 ms: 5.0e-4 J of kinetic energy at the
+    /// 1 ms frame against 4.3e-5 J with 1 ms steps, and an energy scale of
+    /// 3e-4 J). The run goes on from the step's end, so that is the state a
+    /// divergence would show in.
     fn own_state_holds_the_balance(&mut self) -> bool {
         let Some(own) = self.workspace.state_ahead_of_frame() else {
             return false;

@@ -375,10 +375,10 @@ const RATE_FLOOR: f64 = 0.1;
 /// step size, with this step's Jacobian or a fresher one), which the stage
 /// is judged by instead: the rates of one step's stages agree far better
 /// than a step's with the last. On the paper's scene over 1.8 s, 1.85
-/// Newton iterations per stage against 2.20 with `RATE_FLOOR` alone, the
-/// same error estimate's steps within 2 % (3 653 against 3 599) and 14 %
-/// less CPU time, every compared quantity within 0.11 % of the reference
-/// (docs/performance.md, change 12). Without a floor, 1.71 iterations per
+/// Newton iterations per stage against 2.19 with `RATE_FLOOR` alone, the
+/// steps within 2 % (3 653 against 3 599) and 14 % less CPU time, every
+/// compared quantity within 0.11 % of the reference (docs/performance.md,
+/// change 12). Without a floor, 1.71 iterations per
 /// stage and 0.37 % over the first 0.6 s.
 const RATE_FLOOR_IN_STEP: f64 = 0.01;
 
