@@ -902,7 +902,8 @@ fn ideal_cv_link_under_torque(
         .iter()
         .map(|j| {
             let (w, _, _) = j.evaluate(s);
-            (w.bend, w.force, w.torque)
+            let bend = ballcage_core::force::joint::bend(&s.rot[j.a], &s.rot[j.b]);
+            (bend, w.force, w.torque)
         })
         .collect();
     (joints, plane)

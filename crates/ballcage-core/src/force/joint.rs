@@ -34,8 +34,6 @@ pub struct JointWrench {
     pub torque: Vec3,
     /// Twist angle [rad].
     pub twist: f64,
-    /// Bend angle between the body x axes [rad].
-    pub bend: f64,
 }
 
 /// Relative twist of `qb` against `qa` about a's x axis [rad], in (−π, π].
@@ -79,7 +77,6 @@ pub fn cv_joint_wrench(
         force,
         torque,
         twist,
-        bend: bend(qa, qb),
     }
 }
 
