@@ -650,8 +650,7 @@ impl Simulation {
         b.gravity_swing = b
             .gravity_swing
             .max((e.potential_gravity - b.initial_gravity).abs());
-        let created = e.total() - b.initial - b.work_in;
-        let scale = b.initial_free + b.gravity_swing + b.work_abs;
+        let (created, scale) = self.balance.excess(&e, 0.0);
         let limit = self.model.energy_growth * scale;
         if created <= limit || created <= 1e-12 || self.own_state_holds_the_balance() {
             return None;
@@ -684,14 +683,27 @@ impl Simulation {
             return false;
         };
         let e = self.dynamics.energy(&self.model, own);
-        let b = &self.balance;
-        let span = own.t - self.state.t;
-        let swing = b
-            .gravity_swing
-            .max((e.potential_gravity - b.initial_gravity).abs());
-        let created = e.total() - b.initial - (b.work_in + b.power * span);
-        let scale = b.initial_free + swing + b.work_abs + (b.power * span).abs();
+        let (created, scale) = self.balance.excess(&e, own.t - self.state.t);
         created <= self.model.energy_growth * scale
+    }
+}
+
+impl EnergyBalance {
+    /// The energy created at a state of energy `e` [J] `span` [s] past the
+    /// last frame (the input work carried there at the frame's power), and
+    /// the energy scale it is measured against: the most the system could
+    /// hold (initial kinetic and contact energy, gravitational energy
+    /// released, ∫|P_in| dt) [J].
+    fn excess(&self, e: &Energy, span: f64) -> (f64, f64) {
+        let carried = if span == 0.0 { 0.0 } else { self.power * span };
+        let swing = self
+            .gravity_swing
+            .max((e.potential_gravity - self.initial_gravity).abs());
+        let created = e.total() - self.initial - (self.work_in + carried);
+        (
+            created,
+            self.initial_free + swing + self.work_abs + carried.abs(),
+        )
     }
 }
 

@@ -72,7 +72,7 @@ from ballcage.studies.design_chart_grid import (
 )
 from ballcage.studies.refinement import cost_factor
 from ballcage.studies.sweep_quantities import DRILL_PIPE_LIVES, LIVES, LIVES_SECONDS_PER_SIMULATED_SECOND
-from ballcage.studies.sweep_run import SweepResult, pending_cases, sweep
+from ballcage.studies.sweep_run import SweepResult, largest_errors, pending_cases, sweep
 from ballcage.studies.sweep_spec import with_verification
 from ballcage.studies.sweep_summary import COST_COLUMNS
 
@@ -389,14 +389,15 @@ def _error_line(chart: DesignChart) -> str:
     absolute [N] where every value is 0), or why there is none."""
     if not chart.verification:
         return "ballcage: numerical error not measured (--no-verify)"
+    from ballcage.studies.design_chart_plot import PANELS
+
     rows, parts = chart.table.to_pylist(), []
-    for name in ("key_peak_n", "tube_normal_mean_max_n", "tube_normal_mean_all_n", "tube_normal_peak_max_n"):
-        known = [r for r in rows if r[name + "_error"] is not None]
-        relative = [(r[name + "_error"] / abs(r[name]), r[RADIUS], r[LENGTH]) for r in known if r[name]]
-        if relative:
-            worst = max(relative)
-            parts.append(f"{name} {100 * worst[0]:.2g} % (R {worst[1]:g} m, L {worst[2]:g} m)")
-        elif known:
-            parts.append(f"{name} {max(r[name + '_error'] for r in known):.3g} N (every value 0)")
+    worst = {name: (rel, row) for name, rel, row in largest_errors(chart.table, [n for n, _ in PANELS])}
+    for name, _ in PANELS:
+        if name in worst:
+            rel, row = worst[name]
+            parts.append(f"{name} {100 * rel:.2g} % (R {row[RADIUS]:g} m, L {row[LENGTH]:g} m)")
+        elif known := [r[name + "_error"] for r in rows if r[name + "_error"] is not None]:
+            parts.append(f"{name} {max(known):.3g} N (every value 0)")
     head = f"ballcage: largest numerical error (each cell against its run at {chart.verification})"
     return f"{head}: " + "; ".join(parts) if parts else f"{head}: no cell finished both runs"

@@ -10,7 +10,9 @@ numerical-error bar of its tornado charts. One rule, here, for both.
 from __future__ import annotations
 
 import math
+import tomllib
 from dataclasses import dataclass
+from typing import Any
 
 from ballcage import _native
 
@@ -29,6 +31,14 @@ class Tighter:
 
     label: str
     overrides: tuple[str, ...]
+
+    def values(self) -> dict[str, Any]:
+        """The `overrides` as a sweep case's values: dotted key -> value (parsed from its TOML text)."""
+        out = {}
+        for override in self.overrides:
+            key, _, text = override.partition("=")
+            out[key] = tomllib.loads(f"v = {text}")["v"]
+        return out
 
 
 #: The absolute tolerances of ``[simulation]``: ``atol`` and one per quantity.

@@ -14,7 +14,6 @@ SALib is the optional extra ``ballcage[sensitivity]``; `salib` says so when it i
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -140,10 +139,6 @@ def problem(ranges: Sequence[ParameterRange]) -> dict[str, Any]:
 def add_check(design: Design, base: _native.Scene) -> None:
     """Appends the verification case: the base run at ``ballcage run --verify``'s tighter setting."""
     setting = tighter(base)
-    values = {}
-    for override in setting.overrides:
-        key, _, text = override.partition("=")
-        values[key] = tomllib.loads(f"v = {text}")["v"]
-    design.values.append(values)
+    design.values.append(setting.values())
     design.roles.append(Role("verify"))
     design.check = setting

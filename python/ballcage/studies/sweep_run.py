@@ -399,22 +399,23 @@ def describe(result: SweepResult) -> Iterable[str]:
     verification = (result.summary.schema.metadata or {}).get(b"ballcage.sweep_verification", b"").decode()
     if verification:
         worst = largest_errors(result.summary)[:3]
-        text = "; ".join(f"{name} {100 * rel:.2g} % (case {case})" for name, rel, case in worst) or "none measured"
+        text = "; ".join(f"{name} {100 * rel:.2g} % (case {row['case']})" for name, rel, row in worst) or "none measured"
         yield f"ballcage: largest numerical errors (each case against its run at {verification}): {text}"
 
 
-def largest_errors(summary: pa.Table) -> list[tuple[str, float, int]]:
-    """Per quantity with a numerical error column, its largest error relative to the value and that case, largest
-    first; cases whose value is 0 are left out."""
-    rows, out = summary.to_pylist(), []
-    for name in summary.column_names:
-        if not name.endswith("_error") or name.removesuffix("_error") not in summary.column_names:
-            continue
+def largest_errors(table: pa.Table, quantities: Iterable[str] | None = None) -> list[tuple[str, float, dict[str, Any]]]:
+    """Per quantity with a numerical error column (``<quantity>_error``; of `quantities`, by default every one),
+    its largest error relative to the value and that row, largest first; rows whose value is 0 are left out."""
+    rows, out = table.to_pylist(), []
+    names = table.column_names if quantities is None else [q + "_error" for q in quantities]
+    for name in names:
         quantity = name.removesuffix("_error")
-        relative = [(r[name] / abs(r[quantity]), r["case"]) for r in rows if r[name] is not None and r[quantity]]
+        if not name.endswith("_error") or quantity not in table.column_names or name not in table.column_names:
+            continue
+        relative = [(r[name] / abs(r[quantity]), i) for i, r in enumerate(rows) if r[name] is not None and r[quantity]]
         if relative:
-            rel, case = max(relative)
-            out.append((quantity, rel, case))
+            rel, i = max(relative)
+            out.append((quantity, rel, rows[i]))
     return sorted(out, key=lambda x: -x[1])
 
 

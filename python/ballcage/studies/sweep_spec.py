@@ -181,11 +181,7 @@ def with_verification(source: SweepSource) -> SweepSpec:
     checks, labels = [], []
     for case in cases:
         setting = tighter(_native.Scene.from_toml(loaded.base_toml, list(case.overrides)))
-        values = {}
-        for override in setting.overrides:
-            key, _, text = override.partition("=")
-            values[key] = tomllib.loads(f"v = {text}")["v"]
-        checks.append({**case.values, **values})
+        checks.append({**case.values, **setting.values()})
         labels += [setting.label] if setting.label not in labels else []
     return replace(loaded, grid={}, listed=[dict(c.values) for c in cases] + checks, verifies=len(cases),
                    verification=", ".join(labels))  # fmt: skip
