@@ -908,6 +908,7 @@ fn bore_collider(
         start,
         direction,
         segments,
+        ..
     } = &tube.shape
     else {
         return Err(err("bodies", "the bore must be a tube"));

@@ -69,6 +69,28 @@ pub fn angle_between(a: &Vec3, b: &Vec3) -> Real {
     a.cross(b).norm().atan2(a.dot(b))
 }
 
+/// Adams STEP cubic: returns (value, d value / dx). The contact laws' ramps
+/// (`force`) and the tube ends' engagement (`geometry`) both use it.
+///
+/// `STEP(x, x0, h0, x1, h1)` equals `h0` for `x <= x0`, `h1` for `x >= x1`
+/// and `h0 + (h1 - h0) Δ² (3 - 2Δ)` with `Δ = (x - x0) / (x1 - x0)` in
+/// between. It is C¹: the slope vanishes at both ends. Requires `x0 <= x1`
+/// (with `x0 == x1` it is a plain jump at `x0`).
+pub fn step(x: f64, x0: f64, h0: f64, x1: f64, h1: f64) -> (f64, f64) {
+    if x <= x0 {
+        (h0, 0.0)
+    } else if x >= x1 {
+        (h1, 0.0)
+    } else {
+        let width = x1 - x0;
+        let d = (x - x0) / width;
+        let dh = h1 - h0;
+        let value = h0 + dh * d * d * (3.0 - 2.0 * d);
+        let slope = dh * 6.0 * d * (1.0 - d) / width;
+        (value, slope)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

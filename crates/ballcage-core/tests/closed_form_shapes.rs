@@ -9,6 +9,7 @@
 //! Conventions: δ > 0 into the wall; the normal points from the container
 //! (body a) toward the body it holds (b).
 
+use approx::assert_relative_eq;
 use ballcage_core::geometry::{
     ContactPoint, LineContact, LineLaw, PairGeometry, Shape, TubePath, TubeSegment,
 };
@@ -500,4 +501,43 @@ fn a_ball_in_a_window_and_a_sphere_in_a_cavity() {
     let got = parry_contact(&shape, &glam_pose(&pa), &Ball::new(0.031), &glam_pose(&pb))
         .expect("contact");
     assert_world(&got, 1e-4, &n, "cavity, parry");
+}
+
+/// A ball pressing the wall 0.1 mm deep as its centre nears the arc's
+/// downhole end plane, in a tube whose open ends take contact up over
+/// 2 mm (docs/model.md §4): its point carries the share
+/// w = 3x² − 2x³, x = e / 2 mm (the Adams STEP) of its law, e the centre's
+/// distance before the plane, and 1 from 2 mm in; the depth and normal are
+/// those of the wall inside. Past the plane there is no contact, where the
+/// share has already reached 0, so the force does not jump. With sharp ends
+/// the share is 1 up to the plane.
+#[test]
+fn a_ball_nearing_an_open_end_takes_its_share_of_the_wall() {
+    let pa = container_pose();
+    let ball = Shape::ball(0.043);
+    let rounded = Shape::Tube(paper_tube().with_end_engagement(2e-3));
+    let sharp = Shape::Tube(paper_tube());
+    // The end: centreline (1.5, 0, −1.5), tangent +x; offset 15.1 mm
+    // outward (−z) in the end plane: δ = 0.1 mm near it.
+    let end = Vec3::new(1.5, 0.0, -1.5);
+    let at = |e: f64| {
+        let centre = end - e * Vec3::x() - 0.0151 * Vec3::z();
+        (pa.0 + pa.1 * centre, Quat::identity())
+    };
+    for e in [3e-3, 2e-3, 1.5e-3, 1e-3, 0.5e-3, 0.1e-3, 1e-6] {
+        let mut out: Vec<ContactPoint> = vec![];
+        let pb = at(e);
+        PairGeometry::BallTube.contacts(&rounded, (&pa.0, &pa.1), &ball, (&pb.0, &pb.1), &mut out);
+        let x = (e / 2e-3).min(1.0);
+        assert_eq!(out.len(), 1, "e = {e} m");
+        assert_relative_eq!(out[0].weight, x * x * (3.0 - 2.0 * x), epsilon = 1e-9);
+        // The wall's depth near the end: the centreline bends away by e²/2R.
+        assert_relative_eq!(out[0].depth, 1e-4, epsilon = 1e-5);
+        let mut plain: Vec<ContactPoint> = vec![];
+        PairGeometry::BallTube.contacts(&sharp, (&pa.0, &pa.1), &ball, (&pb.0, &pb.1), &mut plain);
+        assert_eq!(plain[0].weight, 1.0, "sharp ends, e = {e} m");
+        assert_eq!(plain[0].depth, out[0].depth, "e = {e} m");
+    }
+    let past = at(-1e-6);
+    assert!(ballcage(PairGeometry::BallTube, &rounded, &pa, &ball, &past).is_empty());
 }

@@ -638,21 +638,30 @@ impl Extremum {
 /// maximum is 2·`samples` where the rod leaves the lumen toward its +s end
 /// and 2·`samples` + 1 where it enters at its −s end: unique and stable,
 /// below 2·`samples` + 2.
+///
+/// Returns, where the rod crosses an open end, the length of its part
+/// inside [m], from its end inside to the last section inside: every
+/// contact above lies on that part, and all vanish together when it shrinks
+/// to nothing. A law that takes their load up over a short length of that
+/// part stays continuous as the rod leaves the lumen (`ballcage-core`'s
+/// tube ends). It is found whether or not a contact lies near the end
+/// where it may be shorter than `measure_below` [m]; longer, it is given
+/// only where the end's own search found it (`None` otherwise).
 pub fn line_extrema<L: Centreline + ?Sized>(
     lumen: &L,
     rod: &Rod,
     ends: Ends,
     samples: u32,
-    threshold: f64,
+    (threshold, measure_below): (f64, f64),
     emit: &mut impl FnMut(LocalContact, Extremum),
-) {
+) -> Option<f64> {
     let link = RodInLumen {
         lumen,
         rod: *rod,
         ends,
         cull: true,
     };
-    link.extrema(samples, threshold, emit);
+    link.extrema(samples, (threshold, measure_below), emit)
 }
 
 impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
@@ -708,10 +717,13 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// Where the rod passes an open end of the lumen between axial
     /// positions `inside` (the axis point `at` there) and `outside` (no
     /// station) [m]: the last position inside, to 1e-12 of the positions,
-    /// and its station; `None` if the rod's part between them cannot reach
+    /// and its station, `None` if the rod's part between them cannot reach
     /// `threshold` (the offset from the centreline grows by at most the
     /// distance along the unit axis, as in [`Self::clear_between`]: leaving
-    /// that part out changes no contact reported).
+    /// that part out changes no contact reported). Where it cannot, the
+    /// position is still found with `locate` (it bounds the part of the rod
+    /// inside, [`line_extrema`]); without, nothing is searched and the
+    /// answer is `None`.
     ///
     /// A station exists while the axis point and the section's deepest
     /// point are both before the end plane: where [`Centreline::past_end`]
@@ -722,11 +734,11 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// positions; by bisection where the lumen has no end plane.
     fn mouth(
         &self,
-        inside: f64,
-        outside: f64,
+        (inside, outside): (f64, f64),
         at: &Axis,
         threshold: f64,
-    ) -> Option<(f64, Station)> {
+        locate: bool,
+    ) -> Option<(f64, Option<Station>)> {
         // The part inside reaches at most as far as the axis point passes
         // the end plane (linear along the axis, no query), or `outside`.
         let plane = |s: f64| self.lumen.past_end(self.rod.at(s));
@@ -735,7 +747,8 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             _ => (outside - inside).abs(),
         };
         let reach = at.offset + length * (1.0 + 1e-12) + self.rod.radius;
-        if self.cull && reach - self.lumen.wall_radius() < threshold - 1e-12 {
+        let culled = self.cull && reach - self.lumen.wall_radius() < threshold - 1e-12;
+        if culled && !locate {
             return None;
         }
         let tolerance = 1e-12 * (1.0 + inside.abs().max(outside.abs()));
@@ -774,8 +787,11 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
                     side = -1;
                 }
             }
+            if culled {
+                return Some((lo, None));
+            }
             if let Some(st) = self.station(lo) {
-                return Some((lo, st));
+                return Some((lo, Some(st)));
             }
             (lo, hi) = (inside, outside);
         }
@@ -787,7 +803,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
                 None => hi = mid,
             }
         }
-        Some((lo, station))
+        Some((lo, (!culled).then_some(station)))
     }
 
     /// How far the station at axial position `s` [m] lies past the lumen's
@@ -813,7 +829,12 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     }
 
     /// [`line_extrema`] of this rod.
-    fn extrema(&self, samples: u32, threshold: f64, emit: &mut impl FnMut(LocalContact, Extremum)) {
+    fn extrema(
+        &self,
+        samples: u32,
+        (threshold, measure_below): (f64, f64),
+        emit: &mut impl FnMut(LocalContact, Extremum),
+    ) -> Option<f64> {
         let link = self;
         let n = samples.max(2) as usize;
         let h = link.rod.half_length;
@@ -832,6 +853,9 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         }
         let mut here = first.map(|st| st.axis);
         let mut last = None;
+        // The length of the part inside [m], where the rod crosses an open
+        // end and it is measured.
+        let mut inside = None;
         for k in 0..n - 1 {
             let next = if k + 2 == n {
                 last = link.station(s(k + 1));
@@ -846,17 +870,27 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
             match (here, next) {
                 (Some(a), Some(b)) => span = Some(((s(k), a), (s(k + 1), b))),
                 (Some(a), None) => {
-                    if let Some((x, st)) = link.mouth(s(k), s(k + 1), &a, threshold) {
-                        span = Some(((s(k), a), (x, st.axis)));
-                        leaving = Some(st).filter(|st| st.axis.growth > 0.0);
+                    // The part inside, [−h, x], is at least s(k) + h long.
+                    let locate = s(k) + h < measure_below;
+                    if let Some((x, st)) = link.mouth((s(k), s(k + 1)), &a, threshold, locate) {
+                        inside = Some(inside.map_or(x + h, |l: f64| l.min(x + h)));
+                        if let Some(st) = st {
+                            span = Some(((s(k), a), (x, st.axis)));
+                            leaving = Some(st).filter(|st| st.axis.growth > 0.0);
+                        }
                     }
                 }
                 (None, Some(b)) => {
-                    if let Some((x, st)) = link.mouth(s(k + 1), s(k), &b, threshold) {
-                        if st.axis.growth <= 0.0 {
-                            put(st, 2 * n + 1, Extremum::Mouth);
+                    // The part inside, [x, h], is at least h − s(k + 1) long.
+                    let locate = h - s(k + 1) < measure_below;
+                    if let Some((x, st)) = link.mouth((s(k + 1), s(k)), &b, threshold, locate) {
+                        inside = Some(inside.map_or(h - x, |l: f64| l.min(h - x)));
+                        if let Some(st) = st {
+                            if st.axis.growth <= 0.0 {
+                                put(st, 2 * n + 1, Extremum::Mouth);
+                            }
+                            span = Some(((x, st.axis), (s(k + 1), b)));
                         }
-                        span = Some(((x, st.axis), (s(k + 1), b)));
                     }
                 }
                 (None, None) => {}
@@ -873,6 +907,7 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         if let Some(st) = last.filter(|st| st.axis.growth > 0.0) {
             put(st, n - 1, Extremum::End);
         }
+        inside
     }
 }
 
@@ -944,7 +979,7 @@ mod tests {
     /// (depth, kind) of every extremum, in axial order.
     fn extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum)> {
         let mut out = vec![];
-        line_extrema(lumen, r, Ends::Flat, samples, 0.0, &mut |c, kind| {
+        line_extrema(lumen, r, Ends::Flat, samples, (0.0, 0.0), &mut |c, kind| {
             out.push((c.depth, kind))
         });
         out
@@ -1052,7 +1087,7 @@ mod tests {
     /// (depth, kind, feature) of every extremum, in axial order.
     fn all_extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum, u32)> {
         let mut out = vec![];
-        line_extrema(lumen, r, Ends::Flat, samples, 0.0, &mut |c, kind| {
+        line_extrema(lumen, r, Ends::Flat, samples, (0.0, 0.0), &mut |c, kind| {
             out.push((c.depth, kind, c.feature))
         });
         out
@@ -1096,7 +1131,9 @@ mod tests {
             ends,
             cull,
         };
-        link.extrema(samples, 0.0, &mut |c, kind| out.push(bits(c, kind as u64)));
+        link.extrema(samples, (0.0, 0.0), &mut |c, kind| {
+            out.push(bits(c, kind as u64))
+        });
         patches(lumen, (r, ends), samples, 0.0, cull, &mut |c| {
             out.push(bits(c, 9))
         });

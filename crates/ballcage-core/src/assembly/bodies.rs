@@ -84,12 +84,16 @@ pub fn shape(spec: &ShapeSpec) -> Shape {
             start,
             direction,
             segments,
-        } => Shape::Tube(TubePath::new(
-            *inner_radius,
-            Vec3::from(*start),
-            Vec3::from(*direction),
-            &segments.iter().map(tube_segment).collect::<Vec<_>>(),
-        )),
+            end_engagement,
+        } => Shape::Tube(
+            TubePath::new(
+                *inner_radius,
+                Vec3::from(*start),
+                Vec3::from(*direction),
+                &segments.iter().map(tube_segment).collect::<Vec<_>>(),
+            )
+            .with_end_engagement(*end_engagement),
+        ),
     }
 }
 

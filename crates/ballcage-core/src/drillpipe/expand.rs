@@ -287,6 +287,7 @@ impl<'a> Builder<'a> {
                     angle_deg: spec.borehole.build_angle_deg,
                     bend: TUBE_BEND,
                 }],
+                end_engagement: spec.borehole.end_engagement,
             },
             ..blank_body()
         };

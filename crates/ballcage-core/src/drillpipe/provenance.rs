@@ -31,6 +31,16 @@ pub const PROVENANCE: &[FieldOrigin] = &[
         "borehole.inner_diameter",
         "Table 1 row 2: guide tube ID 116 mm",
     ),
+    FieldOrigin::proposal(
+        "borehole.end_engagement",
+        Source::Invented,
+        "docs/model.md §4: the paper's tube has sharp open ends, where a link's wall contact vanishes \
+         at once (a jump) as its last section inside leaves; taken up instead over 2 mm of the link's \
+         part inside, about a broken edge's size",
+        (0.0005, 0.01),
+        "0.5 mm, a barely broken edge, to 10 mm, a generous entry chamfer; it acts only while a link \
+         crossing an open end presses the wall, which in the paper's scene never happens",
+    ),
     // pipe
     FieldOrigin::paper("pipe.joints", "§3: 12 flexible joints"),
     FieldOrigin::paper("pipe.pitch", "Table 1 row 4: flexible joint length 200 mm"),

@@ -25,6 +25,10 @@ pub struct BoreholeSpec {
     pub build_angle_deg: f64,
     /// Guide tube inner diameter [m]. Paper (Table 1): 0.116.
     pub inner_diameter: f64,
+    /// Length [m] of a link's part inside over which its wall contact is
+    /// taken up where it crosses an open end of the tube. PROPOSAL: the
+    /// paper's tube has sharp ends, whose contact jumps.
+    pub end_engagement: f64,
 }
 
 impl BoreholeSpec {
@@ -41,6 +45,12 @@ impl BoreholeSpec {
             "build angle of the arc, from vertical",
         ),
         FieldDoc::number("inner_diameter", "m", "guide tube inner diameter D"),
+        FieldDoc::number(
+            "end_engagement",
+            "m",
+            "the tube's open ends: length of a link's part inside over which its wall contact is \
+             taken up (an Adams STEP from 0; 0 = at once, a jump)",
+        ),
     ];
 }
 
@@ -50,6 +60,7 @@ impl Default for BoreholeSpec {
             curvature_radius: 1.5,
             build_angle_deg: 90.0,
             inner_diameter: 0.116,
+            end_engagement: crate::scene::DEFAULT_END_ENGAGEMENT,
         }
     }
 }
@@ -1082,7 +1093,8 @@ impl BoreholeSpec {
                 "must be at most 180",
             ));
         }
-        positive("borehole.inner_diameter", self.inner_diameter)
+        positive("borehole.inner_diameter", self.inner_diameter)?;
+        non_negative("borehole.end_engagement", self.end_engagement)
     }
 }
 

@@ -47,26 +47,7 @@ impl NormalForce {
     }
 }
 
-/// Adams STEP cubic: returns (value, d value / dx).
-///
-/// `STEP(x, x0, h0, x1, h1)` equals `h0` for `x <= x0`, `h1` for `x >= x1`
-/// and `h0 + (h1 - h0) Δ² (3 - 2Δ)` with `Δ = (x - x0) / (x1 - x0)` in
-/// between. It is C¹: the slope vanishes at both ends. Requires `x0 <= x1`
-/// (with `x0 == x1` it is a plain jump at `x0`).
-pub fn step(x: f64, x0: f64, h0: f64, x1: f64, h1: f64) -> (f64, f64) {
-    if x <= x0 {
-        (h0, 0.0)
-    } else if x >= x1 {
-        (h1, 0.0)
-    } else {
-        let width = x1 - x0;
-        let d = (x - x0) / width;
-        let dh = h1 - h0;
-        let value = h0 + dh * d * d * (3.0 - 2.0 * d);
-        let slope = dh * 6.0 * d * (1.0 - d) / width;
-        (value, slope)
-    }
-}
+pub use crate::math::step;
 
 /// Parameters of the MSC Adams IMPACT law (penetration form).
 #[derive(Debug, Clone, Copy, PartialEq)]

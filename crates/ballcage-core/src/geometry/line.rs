@@ -70,19 +70,30 @@ pub(super) fn cylinder_tube(
             turning,
         })
     };
-    match line.law {
+    let inside_length = match line.law {
         LineLaw::LevelSets => line_extrema(
             t.interior(),
             &rod,
             Ends::Flat,
             line.points,
-            0.0,
+            (0.0, t.end_engagement()),
             &mut |c, kind| push(c, Some(kind)),
         ),
         LineLaw::Patches => {
             line_patches(t.interior(), &rod, Ends::Flat, line.points, 0.0, &mut |c| {
                 push(c, None)
-            })
+            });
+            None
+        }
+    };
+    // A link crossing an open end carries its wall contact in proportion to
+    // how much of it is inside (docs/model.md §4, "The tube's open ends").
+    if let Some(length) = inside_length {
+        let w = t.engagement(length);
+        if w < 1.0 {
+            for p in out.filled() {
+                p.weight *= w;
+            }
         }
     }
 }

@@ -680,9 +680,19 @@ fn ball_tube(
             pt.1 * from_glam(core.tangent),
             pt.1 * from_glam(core.curvature),
         );
-        out.push_some(placed(c, pt, |n| {
-            NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
-        }));
+        // Taken up as the centre passes the nearer end plane, as a link's
+        // contact with its part inside (line.rs).
+        let (end, out_of_tube) = inside.nearer_end(centre);
+        let share = t.engagement((end - centre).dot(out_of_tube));
+        out.push_some(
+            placed(c, pt, |n| {
+                NormalTurning::lumen(*pb.0, n, rho, &tangent, &kappa)
+            })
+            .map(|mut p| {
+                p.weight = share;
+                p
+            }),
+        );
     }
 }
 

@@ -55,6 +55,10 @@ impl From<ballcage_shapes::CentrelinePoint> for CentrelinePoint {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TubePath {
     interior: TubeInterior,
+    /// Length [m] of a body's part inside over which its wall contact is
+    /// taken up where it crosses an open end ([`TubePath::engagement`]); 0:
+    /// at once.
+    end_engagement: f64,
 }
 
 impl TubePath {
@@ -81,7 +85,33 @@ impl TubePath {
             .collect();
         Self {
             interior: TubeInterior::new(inner_radius, to_glam(&start), to_glam(&direction), &specs),
+            end_engagement: 0.0,
         }
+    }
+
+    /// The same tube whose open ends take up a crossing body's wall
+    /// contact over `length` [m] of its part inside ([`TubePath::engagement`]).
+    pub fn with_end_engagement(mut self, length: f64) -> Self {
+        self.end_engagement = length;
+        self
+    }
+
+    /// Length [m] over which a crossing body's wall contact is taken up.
+    pub fn end_engagement(&self) -> f64 {
+        self.end_engagement
+    }
+
+    /// The share of its wall contact that a body crossing an open end
+    /// carries when `inside` [m] of it lies inside the tube: an Adams STEP
+    /// from 0 at nothing inside to 1 at [`TubePath::end_engagement`]. The
+    /// contact would otherwise vanish at once, a jump, when the body's last
+    /// section inside leaves the tube while pressing the wall; with the
+    /// share it fades to zero with the part inside. 1 when the length is 0.
+    pub fn engagement(&self, inside: f64) -> f64 {
+        if self.end_engagement <= 0.0 {
+            return 1.0;
+        }
+        crate::math::step(inside, 0.0, 0.0, self.end_engagement, 1.0).0
     }
 
     /// The exact tube, as the parry shape `ballcage_shapes::TubeInterior`.

@@ -68,7 +68,20 @@ pub enum ShapeSpec {
         direction: [f64; 3],
         /// Centreline segments, in order from the start.
         segments: Vec<TubeSegmentSpec>,
+        /// Length [m] of a body's part inside over which its wall contact
+        /// is taken up where it crosses an open end (0: at once, a jump as
+        /// its last section leaves the tube while pressing the wall).
+        #[serde(default = "default_end_engagement")]
+        end_engagement: f64,
     },
+}
+
+/// [`ShapeSpec::Tube`]'s `end_engagement` when not given [m]
+/// (docs/model.md §4, "The tube's open ends").
+pub const DEFAULT_END_ENGAGEMENT: f64 = 0.002;
+
+fn default_end_engagement() -> f64 {
+    DEFAULT_END_ENGAGEMENT
 }
 
 /// One piece of a tube centreline.
@@ -130,6 +143,12 @@ impl ShapeSpec {
             "segments",
             "a tube centreline's segments, in order from its start",
             TubeSegmentSpec::FIELDS,
+        ),
+        FieldDoc::number(
+            "end_engagement",
+            "m",
+            "a tube's open ends: length of a body's part inside over which its wall contact is \
+             taken up (an Adams STEP from 0; 0 = at once, a jump)",
         ),
     ];
 
@@ -220,8 +239,10 @@ impl ShapeSpec {
                 start,
                 direction: dir,
                 segments,
+                end_engagement,
             } => {
                 positive(&format!("{path}.inner_radius"), *inner_radius)?;
+                non_negative(&format!("{path}.end_engagement"), *end_engagement)?;
                 finite_vec(&format!("{path}.start"), start)?;
                 direction(&format!("{path}.direction"), dir)?;
                 if segments.is_empty() {

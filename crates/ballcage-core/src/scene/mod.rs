@@ -16,7 +16,7 @@ mod overrides;
 pub mod provenance;
 mod suggest;
 
-pub use body::{BodySpec, MotionKind, ShapeSpec, TubeSegmentSpec};
+pub use body::{BodySpec, DEFAULT_END_ENGAGEMENT, MotionKind, ShapeSpec, TubeSegmentSpec};
 pub use contact::{
     ContactSpec, FeatureSpec, FieldUnits, FrictionLawSpec, LineLawSpec, NormalLawSpec, law_field,
     scale_from,
