@@ -33,6 +33,31 @@ pub struct Simulation {
     /// The deepest penetration at t = 0 relative to its pair's limit:
     /// (pair, depth [m], depth / limit) (divergence advice).
     initial_deepest: Option<(usize, f64, f64)>,
+    /// How close the run has come to the limits of its divergence checks.
+    closest: Closest,
+}
+
+/// How close a run has come to the limits of its divergence checks, for
+/// its metadata: the deepest penetration relative to its pair's limit
+/// (pair, depth / limit, time [s]), at the end of each step, and the
+/// largest energy created relative to what the check allows, at each
+/// recorded frame (where the check runs).
+#[derive(Debug, Clone, Copy, Default)]
+struct Closest {
+    penetration: Option<(usize, f64, f64)>,
+    energy: f64,
+}
+
+impl Closest {
+    /// Takes in the deepest penetration `deepest` (pair, depth [m],
+    /// depth / limit) seen at time `t` [s].
+    fn see_penetration(&mut self, deepest: Option<(usize, f64, f64)>, t: f64) {
+        if let Some((k, _, ratio)) = deepest
+            && self.penetration.is_none_or(|(_, r, _)| ratio > r)
+        {
+            self.penetration = Some((k, ratio, t));
+        }
+    }
 }
 
 /// What stopped a run, for the advice in its error.
@@ -119,6 +144,11 @@ impl Simulation {
             last_watch: ContactWatch::default(),
             halvings_before_step: 0,
             initial_deepest,
+            closest: {
+                let mut c = Closest::default();
+                c.see_penetration(initial_deepest, 0.0);
+                c
+            },
         }
     }
 
@@ -232,6 +262,8 @@ impl Simulation {
         if let Some(reason) = self.non_finite() {
             return self.fail_with(reason, Failure::NotFinite);
         }
+        self.closest
+            .see_penetration(self.dynamics.watch.deepest, self.state.t);
         if let Some(reason) = self.too_deep() {
             return self.fail_with(reason, Failure::Penetration);
         }
@@ -291,6 +323,7 @@ impl Simulation {
         let complete = self.is_done() && self.failed.is_none();
         let stats = self.workspace.stats();
         let (smallest, error_metadata) = (self.smallest_step(), self.error_metadata());
+        let closest_metadata = self.closest_metadata();
         let mut metadata = vec![
             ("ballcage.scene".to_string(), self.scene_toml),
             ("ballcage.version".to_string(), crate::VERSION.to_string()),
@@ -339,6 +372,7 @@ impl Simulation {
             ("ballcage.complete".to_string(), complete.to_string()),
         ];
         metadata.extend(error_metadata);
+        metadata.extend(closest_metadata);
         if let Some(e) = &self.failed {
             metadata.push(("ballcage.error".to_string(), e.to_string()));
         }
@@ -366,6 +400,34 @@ impl Simulation {
     /// accepted and rejected steps, the accumulated estimate of the global
     /// error (the sums of each step's largest local error on a position
     /// [m] and on a velocity [m/s]) and the tolerances; empty otherwise.
+    /// How close the run came to the limits of its divergence checks
+    /// (`simulation.divergence`): the deepest penetration over its pair's
+    /// limit, with the pair and the time, at the end of the steps; the
+    /// largest energy created over what the check allows, at the frames.
+    /// 1 is the limit; a completed run stayed below it in both.
+    fn closest_metadata(&self) -> Vec<(String, String)> {
+        let mut out = vec![(
+            "ballcage.energy_of_limit".to_string(),
+            format!("{:.6e}", self.closest.energy),
+        )];
+        let (ratio, pair, t) = match self.closest.penetration {
+            Some((k, ratio, t)) => (ratio, self.model.pairs[k].name.clone(), t),
+            None => (0.0, String::new(), 0.0),
+        };
+        out.push((
+            "ballcage.penetration_of_limit".to_string(),
+            format!("{ratio:.6e}"),
+        ));
+        if !pair.is_empty() {
+            out.push(("ballcage.penetration_of_limit_pair".to_string(), pair));
+            out.push((
+                "ballcage.penetration_of_limit_t_s".to_string(),
+                format!("{t:e}"),
+            ));
+        }
+        out
+    }
+
     fn error_metadata(&self) -> Vec<(String, String)> {
         let Some(e) = self.workspace.error_stats() else {
             return vec![];
@@ -652,7 +714,18 @@ impl Simulation {
             .max((e.potential_gravity - b.initial_gravity).abs());
         let (created, scale) = self.balance.excess(&e, 0.0);
         let limit = self.model.energy_growth * scale;
-        if created <= limit || created <= 1e-12 || self.own_state_holds_the_balance() {
+        let share = if created <= 1e-12 {
+            0.0
+        } else if created <= limit {
+            created / limit
+        } else {
+            // The frame failed; its step's own end decides (or the frame).
+            self.own_state_share().unwrap_or(created / limit)
+        };
+        if !share.is_nan() {
+            self.closest.energy = self.closest.energy.max(share);
+        }
+        if share <= 1.0 {
             return None;
         }
         let b = &self.balance;
@@ -667,10 +740,11 @@ impl Simulation {
         ))
     }
 
-    /// Whether, for a frame interpolated within an adaptive step, the
-    /// integrator's own state at the step's end keeps the energy balance
-    /// that the frame failed ([`Self::energy_created`], with the input work
-    /// carried to the step's end at the frame's input power). The
+    /// For a frame interpolated within an adaptive step that failed the
+    /// energy balance, the balance at the integrator's own state at the
+    /// step's end ([`Self::energy_created`], with the input work carried to
+    /// the step's end at the frame's input power): the run stops only if
+    /// that fails too. The
     /// interpolant's error is not controlled: within a step over which a
     /// stiff transient settles, its velocities, cubic Hermite from the
     /// accelerations at the step's ends, overshoot (three ideal-CV links at
@@ -678,13 +752,19 @@ impl Simulation {
     /// 1 ms frame against 4.3e-5 J with 1 ms steps, and an energy scale of
     /// 3e-4 J). The run goes on from the step's end, so that is the state a
     /// divergence would show in.
-    fn own_state_holds_the_balance(&mut self) -> bool {
-        let Some(own) = self.workspace.state_ahead_of_frame() else {
-            return false;
-        };
+    ///
+    /// Returns the energy created there as a share of what the check
+    /// allows, 1 at the limit (`None` without such a state).
+    fn own_state_share(&mut self) -> Option<f64> {
+        let own = self.workspace.state_ahead_of_frame()?;
         let e = self.dynamics.energy(&self.model, own);
         let (created, scale) = self.balance.excess(&e, own.t - self.state.t);
-        created <= self.model.energy_growth * scale
+        let limit = self.model.energy_growth * scale;
+        Some(if created <= 1e-12 {
+            0.0
+        } else {
+            created / limit
+        })
     }
 }
 

@@ -193,8 +193,12 @@ def _failed(error: BaseException, written: Run, out: Path) -> int:
 
 
 def _report(result: Run, fatigue: pa.Table | None = None, wear_map: pa.Table | None = None) -> None:
-    """The lines after the files: the run's cost, wear, fatigue, fallback steps and, last, its verification."""
+    """The lines after the files: the run's cost, how close it came to being stopped, wear, fatigue, fallback steps and,
+    last, its verification."""
     print(_cost(result.metadata))
+    margins = _margins(result.metadata)
+    if margins is not None:
+        print(margins)
     if "wear" in result.tables:
         from ballcage.duty import margin_line, wear_line
 
@@ -232,6 +236,22 @@ def _summary(name: str, path: Path, table: object) -> str:
     if table is None:
         return f"wrote {path}  (resolved scene, {size})"
     return f"wrote {path}  ({table.num_rows} rows x {table.num_columns} columns, {size})"  # type: ignore[attr-defined]
+
+
+def _margins(meta: dict[str, str]) -> str | None:
+    """One line on how close the run came to the limits of its divergence checks (1 = stopped), or None from an
+    engine that does not report it."""
+    if "ballcage.penetration_of_limit" not in meta or "ballcage.energy_of_limit" not in meta:
+        return None
+    depth = float(meta["ballcage.penetration_of_limit"])
+    where = ""
+    if "ballcage.penetration_of_limit_pair" in meta:
+        where = f" (pair {meta['ballcage.penetration_of_limit_pair']}, t = {float(meta['ballcage.penetration_of_limit_t_s']):.3g} s)"
+    energy = float(meta["ballcage.energy_of_limit"])
+    return (
+        f"ballcage: divergence checks (simulation.divergence): deepest penetration {depth:.3g} of its pair's limit{where}; "
+        f"energy created at most {energy:.3g} of what the check allows"
+    )
 
 
 def _cost(meta: dict[str, str]) -> str:
