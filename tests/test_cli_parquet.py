@@ -52,16 +52,16 @@ def test_cli_run_writes_tables_and_scene_and_summarises_each(cli_out):
     for name, line in zip(["bodies.parquet", "contacts.parquet", "scene.toml"], lines[:3], strict=True):
         assert name in line
     assert "rows" in lines[0]
-    # Then what the run cost: 0.2 s simulated with rk4 at 50 µs is 4000 steps.
-    assert "0.2 s simulated" in lines[3] and "real-time factor" in lines[3] and "4000 steps" in lines[3]
-    # Last, how close it came to being stopped: the metadata's shares of the divergence limits.
+    # Then how close it came to being stopped: the metadata's shares of the divergence limits.
     meta = pq.read_table(out / "bodies.parquet").schema.metadata
     depth = float(meta[b"ballcage.penetration_of_limit"])
     pair = meta[b"ballcage.penetration_of_limit_pair"].decode()
     assert 0.0 < depth < 1.0
-    assert lines[4].startswith("ballcage: divergence checks (simulation.divergence): deepest penetration ")
-    assert f"{depth:.3g} of its pair's limit (pair {pair}, t = " in lines[4]
-    assert "energy created at most " in lines[4]
+    assert lines[3].startswith("ballcage: divergence checks (simulation.divergence): deepest penetration ")
+    assert f"{depth:.3g} of its pair's limit (pair {pair}, t = " in lines[3]
+    assert "energy created at most " in lines[3]
+    # Last, what the run cost: 0.2 s simulated with rk4 at 50 µs is 4000 steps.
+    assert "0.2 s simulated" in lines[4] and "real-time factor" in lines[4] and "4000 steps" in lines[4]
     assert proc.stderr == ""  # a 0.2 s scene is too quick for a progress bar
 
 

@@ -396,10 +396,6 @@ impl Simulation {
             .map_or(halved, |e| halved.min(e.smallest_step))
     }
 
-    /// The metadata of an integrator with an error estimate (`esdirk32`):
-    /// accepted and rejected steps, the accumulated estimate of the global
-    /// error (the sums of each step's largest local error on a position
-    /// [m] and on a velocity [m/s]) and the tolerances; empty otherwise.
     /// How close the run came to the limits of its divergence checks
     /// (`simulation.divergence`): the deepest penetration over its pair's
     /// limit, with the pair and the time, at the end of the steps; the
@@ -428,6 +424,10 @@ impl Simulation {
         out
     }
 
+    /// The metadata of an integrator with an error estimate (`esdirk32`):
+    /// accepted and rejected steps, the accumulated estimate of the global
+    /// error (the sums of each step's largest local error on a position
+    /// [m] and on a velocity [m/s]) and the tolerances; empty otherwise.
     fn error_metadata(&self) -> Vec<(String, String)> {
         let Some(e) = self.workspace.error_stats() else {
             return vec![];

@@ -193,12 +193,12 @@ def _failed(error: BaseException, written: Run, out: Path) -> int:
 
 
 def _report(result: Run, fatigue: pa.Table | None = None, wear_map: pa.Table | None = None) -> None:
-    """The lines after the files: the run's cost, how close it came to being stopped, wear, fatigue, fallback steps and,
-    last, its verification."""
-    print(_cost(result.metadata))
+    """The lines after the files: how close the run came to being stopped, its cost, wear, fatigue, fallback steps
+    and, last, its verification."""
     margins = _margins(result.metadata)
     if margins is not None:
         print(margins)
+    print(_cost(result.metadata))
     if "wear" in result.tables:
         from ballcage.duty import margin_line, wear_line
 
