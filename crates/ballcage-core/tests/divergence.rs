@@ -175,4 +175,18 @@ fn energy_created_without_contact_stops_the_run() {
     assert!(text.contains("no contact was active"), "{text}");
     assert!(e.time <= 0.1, "caught late, at {} s", e.time);
     assert!(sim.state().vel.iter().all(|v| v.norm().is_finite()));
+    // The metadata reports the share of the energy limit that stopped it,
+    // above 1, and, without contact, no penetration and no pair.
+    let meta = sim.finish().metadata;
+    let value = |key: &str| meta.iter().find(|(k, _)| k == key).map(|(_, v)| v.clone());
+    let share: f64 = value("ballcage.energy_of_limit")
+        .expect("reported")
+        .parse()
+        .unwrap();
+    assert!(share > 1.0, "energy share {share}");
+    assert_eq!(
+        value("ballcage.penetration_of_limit").as_deref(),
+        Some("0.000000e0")
+    );
+    assert_eq!(value("ballcage.penetration_of_limit_pair"), None);
 }
