@@ -13,35 +13,19 @@ mod common;
 /// linear contact spring of k [N/m], 0.2 s, with the given penetration
 /// fraction; the run's metadata.
 fn placed(k: f64, fraction: f64, depth: f64) -> Vec<(String, String)> {
-    let (m, g, r) = (2.0, 9.81, 0.01);
-    let toml = format!(
-        r#"
-        [simulation]
-        duration = 0.2
-        dt = 1e-4
-        output_interval = 1e-3
-        integrator = "sdirk2"
-        [simulation.divergence]
-        penetration_fraction = {fraction}
-        [world]
-        gravity = [0.0, 0.0, {neg_g}]
-        [[bodies]]
-        name = "ground"
-        motion = "fixed"
-        shape = {{ type = "half-space", normal = [0.0, 0.0, 1.0] }}
-        [[bodies]]
-        name = "ball"
-        shape = {{ type = "ball", radius = {r} }}
-        mass = {m}
-        position = [0.0, 0.0, {z}]
-        [[contacts]]
-        bodies = ["ground", "ball"]
-        normal = {{ law = "linear", stiffness = {k}, damping = 3000.0 }}
-        "#,
-        neg_g = -g,
-        z = r - depth,
+    let r = 0.01;
+    let mut sim = common::ball_on_floor(
+        &format!(
+            "duration = 0.2\ndt = 1e-4\noutput_interval = 1e-3\nintegrator = \"sdirk2\"\n\
+             divergence = {{ penetration_fraction = {fraction} }}"
+        ),
+        9.81,
+        &format!(
+            "shape = {{ type = \"ball\", radius = {r} }}\nmass = 2.0\nposition = [0.0, 0.0, {z}]",
+            z = r - depth
+        ),
+        &format!("normal = {{ law = \"linear\", stiffness = {k}, damping = 3000.0 }}"),
     );
-    let mut sim = common::sim(&toml);
     let _ = sim.run();
     sim.finish().metadata
 }
@@ -79,7 +63,7 @@ fn a_resting_ball_reports_its_depth_over_the_limit() {
         );
         assert_eq!(
             value(&meta, "ballcage.penetration_of_limit_pair"),
-            "ground/ball"
+            "floor/ball"
         );
         let energy = number(&meta, "ballcage.energy_of_limit");
         assert!((0.0..1e-3).contains(&energy), "energy share {energy}");
