@@ -153,6 +153,7 @@ impl Range<'_> {
                 points: SlotSink {
                     slots: &mut self.points[s..e],
                     len: 0,
+                    turning: couplings.is_some(),
                 },
                 laws: &mut self.laws[s..e],
                 latched: &mut self.latched[ms..me],

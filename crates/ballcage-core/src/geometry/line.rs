@@ -57,13 +57,20 @@ pub(super) fn cylinder_tube(
         radius,
     };
     let inside = t.interior();
+    // The turning costs nearest-point queries of its own: only for a Jacobian.
+    let wants_turning = out.wants_turning();
     let mut push = |c: ballcage_shapes::LocalContact, kind: Option<Extremum>| {
         let weight = kind.map_or(1.0, Extremum::weight);
         let normal = pt.1 * from_glam(c.normal);
-        let turning = turning(&c, kind, &rod, inside, pt);
+        let point = pt.0 + pt.1 * from_glam(c.point);
+        let turning = if wants_turning {
+            turning(&c, kind, &rod, inside, pt)
+        } else {
+            NormalTurning::plane(point)
+        };
         out.push(ContactPoint {
             slot: c.feature,
-            point: pt.0 + pt.1 * from_glam(c.point),
+            point,
             normal,
             depth: c.depth,
             weight,

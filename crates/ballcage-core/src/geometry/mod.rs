@@ -107,7 +107,9 @@ pub struct ContactPoint {
     /// and the elastic energy of the point are multiplied by it.
     pub weight: f64,
     /// How the normal turns as the bodies move, for the geometric terms
-    /// of the Jacobian.
+    /// of the Jacobian: only that reads it, so a query may leave it
+    /// [`NormalTurning::plane`] at the point where its sink does not want it
+    /// ([`PointSink::wants_turning`]) and it costs a query of its own.
     pub turning: NormalTurning,
 }
 
@@ -123,6 +125,13 @@ pub trait PointSink {
 
     /// The points appended since the last [`PointSink::clear`].
     fn filled(&mut self) -> &mut [ContactPoint];
+
+    /// Whether the points' [`ContactPoint::turning`] will be read (by the
+    /// Jacobian); true unless the sink says otherwise.
+    #[inline]
+    fn wants_turning(&self) -> bool {
+        true
+    }
 
     /// Appends `point` if there is one.
     #[inline]
@@ -156,6 +165,8 @@ pub struct SlotSink<'a> {
     pub slots: &'a mut [ContactPoint],
     /// How many are filled.
     pub len: usize,
+    /// Whether the points' turning is wanted (a Jacobian evaluation).
+    pub turning: bool,
 }
 
 impl PointSink for SlotSink<'_> {
@@ -177,6 +188,11 @@ impl PointSink for SlotSink<'_> {
 
     fn filled(&mut self) -> &mut [ContactPoint] {
         &mut self.slots[..self.len]
+    }
+
+    #[inline]
+    fn wants_turning(&self) -> bool {
+        self.turning
     }
 }
 
@@ -787,6 +803,7 @@ mod tests {
         let mut sink = SlotSink {
             slots: &mut slots,
             len: 0,
+            turning: true,
         };
         for depth in [1.0, 2.0, 3.0] {
             let mut p = ContactPoint::UNUSED;
