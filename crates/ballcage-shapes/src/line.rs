@@ -34,7 +34,7 @@
 
 use parry3d_f64::math::Vector;
 
-use crate::centreline::Centreline;
+use crate::centreline::{Centreline, CircularArc};
 use crate::contact::{LocalContact, Rod, unit};
 
 /// The ends of a rod.
@@ -55,6 +55,89 @@ struct RodInLumen<'a, L: ?Sized> {
     /// ([`Self::clear_between`]); always, but in the test that shows it
     /// changes nothing.
     cull: bool,
+    /// The rod's axis against the lumen's centreline in closed form, where
+    /// that is one circular arc ([`Centreline::arc`]).
+    on_arc: Option<AxisOnArc>,
+}
+
+impl<'a, L: Centreline + ?Sized> RodInLumen<'a, L> {
+    fn new(lumen: &'a L, rod: Rod, ends: Ends, cull: bool) -> Self {
+        let on_arc = lumen.arc().map(|arc| AxisOnArc::new(&arc, &rod));
+        Self {
+            lumen,
+            rod,
+            ends,
+            cull,
+            on_arc,
+        }
+    }
+}
+
+/// A straight axis q(s) = p + s·â against a circular-arc centreline (centre
+/// o, radius R, start direction û, start tangent t̂, plane normal n̂ = û × t̂).
+/// With r = q − o, the coordinates x = r·û, y = r·t̂, z = r·n̂ are linear in
+/// s, and where the direction (x, y)/ρ (ρ = √(x² + y²)) lies within the arc
+/// its nearest point is o + R·(x·û + y·t̂)/ρ. Then, with ĉ = (x·û + y·t̂)/ρ
+/// and the tangent t̂(s) = (x·t̂ − y·û)/ρ:
+/// - u·â = r·â − R·ĉ·â, r·â = r(0)·â + s;
+/// - the slope 1 − β·(t̂(s)·â)² with β = 1/(1 − u·κ) = R/ρ (κ = −ĉ/R and
+///   u·ĉ = ρ − R);
+/// - |u| = √((ρ − R)² + z²).
+///
+/// That is [`Axis`] for a few multiplications and two square roots, where the
+/// nearest-point query would build the centreline point first.
+#[derive(Clone, Copy)]
+struct AxisOnArc {
+    arc: CircularArc,
+    /// x, y, z and r·â at s = 0 [m].
+    at_centre: [f64; 4],
+    /// â·û, â·t̂, â·n̂.
+    along: [f64; 3],
+}
+
+impl AxisOnArc {
+    fn new(arc: &CircularArc, rod: &Rod) -> Self {
+        let n = arc.u.cross(arc.t);
+        let r = rod.centre - arc.centre;
+        let a = rod.axis;
+        Self {
+            arc: *arc,
+            at_centre: [r.dot(arc.u), r.dot(arc.t), r.dot(n), r.dot(a)],
+            along: [a.dot(arc.u), a.dot(arc.t), a.dot(n)],
+        }
+    }
+
+    /// The axis point at `s` [m]: its (cos, sin) direction ĉ in the arc's
+    /// plane and [`Axis`]; `None` where that direction is not within the
+    /// arc's angle or the point is on the circle's axis (the caller then
+    /// asks the lumen).
+    #[inline]
+    fn at(&self, s: f64) -> Option<((f64, f64), Axis)> {
+        let [x0, y0, z0, g0] = self.at_centre;
+        let [au, at, an] = self.along;
+        let (x, y, z) = (x0 + s * au, y0 + s * at, z0 + s * an);
+        let rho = (x * x + y * y).sqrt();
+        if rho.is_nan() || rho == 0.0 {
+            return None;
+        }
+        let (c, sn) = (x / rho, y / rho);
+        let (ca, sa) = self.arc.end;
+        // Within [0, angle] (angle ≤ π): past the start, up to the end.
+        if !(sn >= 0.0 && ca * sn - sa * c <= 0.0) {
+            return None;
+        }
+        let big_r = self.arc.radius;
+        let tangent = c * at - sn * au;
+        let radial = rho - big_r;
+        Some((
+            (c, sn),
+            Axis {
+                growth: g0 + s - big_r * (c * au + sn * at),
+                slope: 1.0 - (big_r / rho) * tangent * tangent,
+                offset: (radial * radial + z * z).sqrt(),
+            },
+        ))
+    }
 }
 
 /// The rod's axis point at one axial position against the centreline:
@@ -103,6 +186,11 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// open ends.
     fn axis_at(&self, s: f64) -> Option<(Vector, Vector, Axis)> {
         let q = self.rod.at(s);
+        if let Some(((c, sn), axis)) = self.on_arc.as_ref().and_then(|on| on.at(s)) {
+            let arc = &self.on_arc.as_ref()?.arc;
+            let u = q - (arc.centre + arc.radius * (c * arc.u + sn * arc.t));
+            return Some((q, u, axis));
+        }
         let c = self.lumen.nearest(q)?;
         let u = q - c.point;
         let beta = 1.0 / (1.0 - u.dot(c.curvature));
@@ -116,6 +204,9 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
 
     /// [`Self::axis_at`] without the points.
     fn axis(&self, s: f64) -> Option<Axis> {
+        if let Some((_, axis)) = self.on_arc.as_ref().and_then(|on| on.at(s)) {
+            return Some(axis);
+        }
         self.axis_at(s).map(|(.., axis)| axis)
     }
 
@@ -248,61 +339,63 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         }
         if up {
             // + → − (a maximum) then − → + (a minimum).
-            let max = self.stationary((sa, a.growth), (lo, turn.growth), 1.0)?;
-            let min = self.stationary((lo, -turn.growth), (sb, -b.growth), -1.0)?;
+            let max = self.stationary((sa, a), (lo, &turn), 1.0)?;
+            let min = self.stationary((lo, &turn), (sb, b), -1.0)?;
             Some((max, min))
         } else {
-            let min = self.stationary((sa, -a.growth), (lo, -turn.growth), -1.0)?;
-            let max = self.stationary((lo, turn.growth), (sb, b.growth), 1.0)?;
+            let min = self.stationary((sa, a), (lo, &turn), -1.0)?;
+            let max = self.stationary((lo, &turn), (sb, b), 1.0)?;
             Some((max, min))
         }
     }
 
     /// The axial position in `[a, b]` where the offset from the centreline
-    /// stops growing (u·â = 0, the depth's maximum), given u·â = `ga` > 0 at
-    /// `a` and `gb` ≤ 0 at `b` ([`Self::stationary`]). `None` if a station
-    /// on the way does not exist.
-    fn deepest(&self, a: (f64, f64), b: (f64, f64)) -> Option<f64> {
+    /// stops growing (u·â = 0, the depth's maximum), given u·â > 0 at `a`
+    /// and ≤ 0 at `b` ([`Self::stationary`]). `None` if a station on the way
+    /// does not exist.
+    fn deepest(&self, a: (f64, &Axis), b: (f64, &Axis)) -> Option<f64> {
         self.stationary(a, b, 1.0)
     }
 
     /// The axial position in `[a, b]` where u·â changes sign: with
     /// `sign` = 1 from positive at `a` to non-positive at `b` (a depth
     /// maximum, see [`Self::deepest`]); with `sign` = −1 from non-positive
-    /// to positive (a depth minimum). The growths given are multiplied by
-    /// `sign`, so `ga` > 0 ≥ `gb` either way.
+    /// to positive (a depth minimum). Both ends' axis points are given; the
+    /// search works on sign·u·â, positive at `a` and non-positive at `b`
+    /// either way.
     ///
     /// Newton's method on u·â with its exact slope d(u·â)/ds, which each
-    /// station computes (quadratic: two or three stations from the first
-    /// estimate), kept inside the bracket, which every station narrows: a
-    /// Newton step that leaves the bracket, or does not halve the step
-    /// before it, is replaced by the Illinois variant of regula falsi (the
-    /// slope jumps where the centreline's curvature does). Stops when the
-    /// bracket or the last step is within 1e-12 of the positions.
-    fn stationary(
-        &self,
-        (mut a, mut ga): (f64, f64),
-        (mut b, mut gb): (f64, f64),
-        sign: f64,
-    ) -> Option<f64> {
+    /// axis point computes, kept inside the bracket, which every axis point
+    /// narrows. The first estimate is the root of the cubic that matches
+    /// u·â and its slope at both ends ([`hermite_root`]); a Newton step that
+    /// leaves the bracket, or does not halve the step before it, is replaced
+    /// by the Illinois variant of regula falsi (the slope jumps where the
+    /// centreline's curvature does). Newton converges quadratically here,
+    /// so a step c after a step c₋ lands within |c|³/c₋² of the root: once
+    /// that is within 1e-12 of the positions and |c| ≤ 1e-3·|c₋| (the
+    /// iteration plainly quadratic, not crossing a jump of the slope), the
+    /// position after that step is returned without an axis point of its
+    /// own (the caller's station there is the one query it needs). Stops too
+    /// when the bracket or the last step is within 1e-12 of the positions.
+    fn stationary(&self, (a, at): (f64, &Axis), (b, bt): (f64, &Axis), sign: f64) -> Option<f64> {
+        let (mut a, mut ga, mut b, mut gb) = (a, sign * at.growth, b, sign * bt.growth);
         if ga == 0.0 {
             return Some(a);
         }
         let tolerance = 1e-12 * (1.0 + b.abs().max(a.abs()));
+        let mut first = hermite_root((a, ga, sign * at.slope), (b, gb, sign * bt.slope));
         // Which end moved last: +1 for a, −1 for b.
         let mut side = 0;
-        // The last station: its position, sign·u·â, sign·slope, and the step to it.
+        // The last axis point: its position, sign·u·â, sign·slope, and the step to it.
         let mut last: Option<(f64, f64, f64, f64)> = None;
         for _ in 0..100 {
             if b - a <= tolerance {
                 break;
             }
-            let newton = last.and_then(|(x, g, slope, step)| {
-                let next = x - g / slope;
-                let fine = slope != 0.0 && next > a && next < b && (next - x).abs() <= 0.5 * step;
-                fine.then_some(next)
-            });
-            let x = newton.unwrap_or_else(|| {
+            let newton =
+                last.and_then(|(x, g, slope, step)| newton_step(x, g, slope, step, (a, b)));
+            let first = first.take().filter(|&x| x > a && x < b);
+            let x = newton.or(first).unwrap_or_else(|| {
                 let x = (a * gb - b * ga) / (gb - ga);
                 if x > a && x < b { x } else { 0.5 * (a + b) }
             });
@@ -325,6 +418,12 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
                 }
                 side = -1;
             }
+            if newton.is_some()
+                && let Some(next) = newton_step(x, gx, slope, step, (a, b))
+                && converged(next - x, step, tolerance)
+            {
+                return Some(next);
+            }
             last = Some((x, gx, slope, step));
         }
         Some(if ga.abs() < gb.abs() { a } else { b })
@@ -343,11 +442,66 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         if !(a.growth > 0.0 && b.growth <= 0.0) || self.clear_between((sa, a), (sb, b), threshold) {
             return None;
         }
-        let x = self.deepest((sa, a.growth), (sb, b.growth))?;
+        let x = self.deepest((sa, a), (sb, b))?;
         self.station(x)
             .filter(|st| st.depth > threshold)
             .map(|st| (x, st))
     }
+}
+
+/// The Newton step from `x` (where the function is `g` and its slope
+/// `slope`) if it stays strictly inside the bracket and is at most half the
+/// `step` before it (otherwise the search falls back to regula falsi).
+fn newton_step(x: f64, g: f64, slope: f64, step: f64, (a, b): (f64, f64)) -> Option<f64> {
+    let next = x - g / slope;
+    let fine = slope != 0.0 && next > a && next < b && (next - x).abs() <= 0.5 * step;
+    fine.then_some(next)
+}
+
+/// Whether Newton's step `c` after a step of length `step`, both [m], ends
+/// within `tolerance` [m] of the root by quadratic convergence
+/// ([`RodInLumen::stationary`]).
+fn converged(c: f64, step: f64, tolerance: f64) -> bool {
+    let c = c.abs();
+    c <= 1e-3 * step && c * c * c <= tolerance * step * step
+}
+
+/// The root in (a, b) of the cubic that takes the values `ga`, `gb` and
+/// the slopes `sa`, `sb` at a and b (Hermite), found by Newton's method on
+/// the cubic from the regula falsi point: a first estimate for
+/// [`RodInLumen::stationary`] that costs no query. Exact where the function
+/// is a cubic; `None` where the iteration leaves the bracket or does not
+/// settle (the search then starts from regula falsi).
+fn hermite_root((a, ga, sa): (f64, f64, f64), (b, gb, sb): (f64, f64, f64)) -> Option<f64> {
+    let h = b - a;
+    if h.is_nan() || h <= 0.0 || ga == gb {
+        return None;
+    }
+    let (ma, mb) = (sa * h, sb * h);
+    let mut t = ga / (ga - gb);
+    for _ in 0..8 {
+        let (t2, t3) = (t * t, t * t * t);
+        let p = (2.0 * t3 - 3.0 * t2 + 1.0) * ga
+            + (t3 - 2.0 * t2 + t) * ma
+            + (3.0 * t2 - 2.0 * t3) * gb
+            + (t3 - t2) * mb;
+        let dp = (6.0 * t2 - 6.0 * t) * (ga - gb)
+            + (3.0 * t2 - 4.0 * t + 1.0) * ma
+            + (3.0 * t2 - 2.0 * t) * mb;
+        if dp == 0.0 {
+            return None;
+        }
+        let next = t - p / dp;
+        if !(next > 0.0 && next < 1.0) {
+            return None;
+        }
+        let settled = (next - t).abs() <= 1e-10;
+        t = next;
+        if settled {
+            return Some(a + t * h);
+        }
+    }
+    None
 }
 
 /// What the walk along the axis finds, in order.
@@ -377,12 +531,7 @@ fn walk<L: Centreline + ?Sized>(
     cull: bool,
     visit: &mut impl FnMut(Event<'_>),
 ) {
-    let link = RodInLumen {
-        lumen,
-        rod: *rod,
-        ends,
-        cull,
-    };
+    let link = RodInLumen::new(lumen, *rod, ends, cull);
     let n = samples.max(2) as usize;
     let h = rod.half_length;
     let s = |k: usize| -h + 2.0 * h * k as f64 / (n - 1) as f64;
@@ -655,12 +804,7 @@ pub fn line_extrema<L: Centreline + ?Sized>(
     (threshold, measure_below): (f64, f64),
     emit: &mut impl FnMut(LocalContact, Extremum),
 ) -> Option<f64> {
-    let link = RodInLumen {
-        lumen,
-        rod: *rod,
-        ends,
-        cull: true,
-    };
+    let link = RodInLumen::new(lumen, *rod, ends, true);
     link.extrema(samples, (threshold, measure_below), emit)
 }
 
@@ -700,10 +844,10 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
         }
         let found = match (a.growth > 0.0, b.growth > 0.0) {
             (true, false) => self
-                .stationary((sa, a.growth), (sb, b.growth), 1.0)
+                .stationary((sa, a), (sb, b), 1.0)
                 .map(|x| (x, k, Extremum::Maximum)),
             (false, true) => self
-                .stationary((sa, -a.growth), (sb, -b.growth), -1.0)
+                .stationary((sa, a), (sb, b), -1.0)
                 .map(|x| (x, n + k, Extremum::Minimum)),
             _ => None,
         };
@@ -766,8 +910,15 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
                     break;
                 }
                 let x = lo + (hi - lo) * (glo / (glo - ghi));
-                let between = (x - lo) * (hi - x) > 0.0;
-                let x = if between { x } else { 0.5 * (lo + hi) };
+                let x = if (x - lo) * (hi - x) > 0.0 {
+                    x
+                } else if ghi <= tolerance {
+                    // Regula falsi lands on `hi`, past the plane by round-off
+                    // only: half a tolerance before it (not ~20 bisections).
+                    hi - 0.5 * tolerance * (hi - lo).signum()
+                } else {
+                    0.5 * (lo + hi)
+                };
                 let Some(gx) = self.past_end(x) else { break };
                 if gx <= 0.0 {
                     (lo, glo) = (x, gx);
@@ -1109,6 +1260,197 @@ mod tests {
         }
     }
 
+    /// The paper's bend behind the trait's defaults: no closed form along
+    /// the arc, every axis point a nearest-point query.
+    struct Generic<'a>(&'a TubeInterior);
+
+    impl Centreline for Generic<'_> {
+        fn nearest(&self, q: Vector) -> Option<crate::centreline::CentrelinePoint> {
+            self.0.nearest(q)
+        }
+        fn wall_radius(&self) -> f64 {
+            self.0.wall_radius()
+        }
+        fn past_end(&self, q: Vector) -> Option<f64> {
+            self.0.past_end(q)
+        }
+    }
+
+    /// [`line_extrema`] at 5 samples, every contact and its kind, and the
+    /// length inside an open end (measured below 0.1 m).
+    fn extrema_inside<L: Centreline>(
+        lumen: &L,
+        r: &Rod,
+        ends: Ends,
+    ) -> (Vec<(LocalContact, Extremum)>, Option<f64>) {
+        let mut out = vec![];
+        let inside = line_extrema(lumen, r, ends, 5, (0.0, 0.1), &mut |c, kind| {
+            out.push((c, kind))
+        });
+        (out, inside)
+    }
+
+    /// The closed form along an arc ([`AxisOnArc`]) finds the extrema the
+    /// nearest-point queries find: the same contacts, kinds and features,
+    /// depths within 1e-15 m, points within 1e-11 m, normals within 1e-11,
+    /// and the same length inside an open end; on 3000 poses of a link in
+    /// the paper's bend and across both its open ends, both end types.
+    /// Hand-made axis points check the closed form's three quantities.
+    #[test]
+    fn the_closed_form_along_an_arc_matches_the_nearest_point_queries() {
+        let arc = crate::tube::tests::paper_tube();
+        assert!(arc.arc().is_some() && Generic(&arc).arc().is_none());
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut uniform = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut compared, mut crossing) = (0, 0);
+        for case in 0..3000 {
+            // Centres from 0.15 m before the entry to 0.15 m past the exit.
+            let along = -0.15 + (arc.length() + 0.3) * uniform();
+            let c = arc.point_at(along.clamp(0.0, arc.length()));
+            let centre = c.point + (along - along.clamp(0.0, arc.length())) * c.tangent;
+            let mut random = || Vector::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
+            let across = unit(c.tangent.cross(random()));
+            let tilt = unit(random());
+            let r = rod(
+                centre + (0.017 * uniform()) * across,
+                unit(c.tangent + 0.1 * uniform() * tilt),
+            );
+            let ends = if case % 2 == 0 {
+                Ends::Flat
+            } else {
+                Ends::Round
+            };
+            let (fast, fast_inside) = extrema_inside(&arc, &r, ends);
+            let (slow, slow_inside) = extrema_inside(&Generic(&arc), &r, ends);
+            assert_eq!(fast.len(), slow.len(), "case {case}");
+            assert_eq!(fast_inside.is_some(), slow_inside.is_some(), "case {case}");
+            if let (Some(a), Some(b)) = (fast_inside, slow_inside) {
+                assert!(
+                    (a - b).abs() < 1e-11,
+                    "case {case}: {a} against {b} m inside"
+                );
+                crossing += 1;
+            }
+            for ((f, fk), (g, gk)) in fast.iter().zip(&slow) {
+                assert_eq!((fk, f.feature), (gk, g.feature), "case {case}");
+                assert!(
+                    (f.depth - g.depth).abs() < 1e-15,
+                    "case {case}: {} against {}",
+                    f.depth,
+                    g.depth
+                );
+                assert!((f.point - g.point).length() < 1e-11, "case {case}");
+                assert!((f.normal - g.normal).length() < 1e-11, "case {case}");
+                compared += 1;
+            }
+        }
+        assert!(
+            compared > 1000 && crossing > 100,
+            "{compared} contacts, {crossing} rods crossing an end"
+        );
+        // By hand: a rod along the centreline's tangent at the arc's middle,
+        // displaced by d toward the circle's centre and by h out of plane, at
+        // s along it: r = (R − d)·ĉ + h·n̂ + s·t̂, so u·â = s − R·s/ρ with
+        // ρ = √((R − d)² + s²), the slope 1 − R(R − d)²/ρ³ and the offset
+        // √((ρ − R)² + h²).
+        let (big_r, d, h) = (1.5, 0.01, 0.004);
+        let mid = arc.point_at(0.5 * arc.length());
+        let toward = mid.curvature / mid.curvature.length();
+        let out_of_plane = unit(mid.tangent.cross(toward));
+        let r = rod(mid.point + d * toward + h * out_of_plane, mid.tangent);
+        let link = RodInLumen::new(&arc, r, Ends::Round, true);
+        for s in [-0.1, 0.03, 0.12] {
+            let axis = link.axis(s).expect("inside the bend");
+            let rho = ((big_r - d) * (big_r - d) + s * s).sqrt();
+            let slope = 1.0 - big_r * (big_r - d) * (big_r - d) / rho.powi(3);
+            let offset = ((rho - big_r).powi(2) + h * h).sqrt();
+            assert!(
+                (axis.growth - (s - big_r * s / rho)).abs() < 1e-15,
+                "growth at {s}"
+            );
+            assert!((axis.slope - slope).abs() < 1e-12, "slope at {s}");
+            assert!((axis.offset - offset).abs() < 1e-15, "offset at {s}");
+        }
+    }
+
+    /// The first estimate is exact on a cubic: u·â = (s − r)(s² + 0.3) on
+    /// [−0.1, 0.2] has its root r found to 1e-15 from the ends' values and
+    /// slopes alone, where regula falsi is 0.01 off.
+    #[test]
+    fn the_hermite_start_is_exact_on_a_cubic() {
+        for r in [-0.07, 0.0, 0.05, 0.18] {
+            let g = |s: f64| (s - r) * (s * s + 0.3);
+            let slope = |s: f64| (s * s + 0.3) + 2.0 * s * (s - r);
+            let (a, b) = (-0.1, 0.2);
+            let found = hermite_root((a, g(a), slope(a)), (b, g(b), slope(b))).expect("a root");
+            assert!((found - r).abs() < 1e-15, "{found} against {r}");
+            let falsi = (a * g(b) - b * g(a)) / (g(b) - g(a));
+            assert!((falsi - r).abs() > 1e-3, "regula falsi {falsi} against {r}");
+        }
+    }
+
+    /// Each root of u·â between two samples is found to round-off (|u·â|
+    /// below 2e-15 m where the slope is about 1e-2: the root within about
+    /// 1e-13 m) with fewer than 2.5 nearest-point queries on average, on
+    /// 2000 poses of a link in the paper's bend (nearest-point queries, not
+    /// the closed form along the arc): Newton from the Hermite start,
+    /// stopped by the quadratic prediction, 2.11 queries and |u·â| ≤ 4.3e-16
+    /// m. From regula falsi with the same stop: 3.12 and 8.5e-15 m; from
+    /// regula falsi, stopped by a step below 1e-12 (before 2026-11-27):
+    /// 5.04 and 3.6e-16 m.
+    #[test]
+    fn a_root_between_samples_costs_few_queries_and_is_exact() {
+        let arc = crate::tube::tests::paper_tube();
+        let lumen = Counting {
+            tube: &arc,
+            queries: std::cell::Cell::new(0),
+        };
+        let mut seed = 0x1234_5678_9abc_def1_u64;
+        let mut uniform = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut roots, mut queries, mut worst) = (0, 0, 0.0_f64);
+        for _ in 0..2000 {
+            let c = arc.point_at(0.2 + 2.0 * uniform());
+            let mut random = || Vector::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
+            let across = unit(c.tangent.cross(random()));
+            let tilt = unit(random());
+            let centre = c.point + (0.017 * uniform()) * across;
+            let r = rod(centre, unit(c.tangent + 0.1 * uniform() * tilt));
+            let link = RodInLumen::new(&lumen, r, Ends::Round, false);
+            let s = |k: usize| -0.1 + 0.05 * k as f64;
+            for k in 0..4 {
+                let (Some(a), Some(b)) = (link.axis(s(k)), link.axis(s(k + 1))) else {
+                    continue;
+                };
+                let sign = match (a.growth > 0.0, b.growth > 0.0) {
+                    (true, false) => 1.0,
+                    (false, true) => -1.0,
+                    _ => continue,
+                };
+                lumen.queries.set(0);
+                let x = link
+                    .stationary((s(k), &a), (s(k + 1), &b), sign)
+                    .expect("a root");
+                queries += lumen.queries.get();
+                roots += 1;
+                worst = worst.max(link.axis(x).expect("inside").growth.abs());
+            }
+        }
+        assert!(roots > 500, "{roots} roots");
+        assert!(worst < 2e-15, "|u·â| up to {worst:e} m at a root");
+        let mean = queries as f64 / roots as f64;
+        assert!(mean < 2.5, "{mean} queries per root");
+    }
+
     /// Every contact the level-set and patch reductions report, as bits.
     fn reported(lumen: &Counting, r: &Rod, ends: Ends, samples: u32, cull: bool) -> Vec<[u64; 8]> {
         let bits = |c: LocalContact, kind: u64| {
@@ -1125,12 +1467,7 @@ mod tests {
             ]
         };
         let mut out = vec![];
-        let link = RodInLumen {
-            lumen,
-            rod: *r,
-            ends,
-            cull,
-        };
+        let link = RodInLumen::new(lumen, *r, ends, cull);
         link.extrema(samples, (0.0, 0.0), &mut |c, kind| {
             out.push(bits(c, kind as u64))
         });
@@ -1188,7 +1525,7 @@ mod tests {
             "{touching} of 8000 runs touch"
         );
         assert!(
-            (with as f64) < 0.95 * without as f64,
+            (with as f64) < 0.98 * without as f64,
             "{with} against {without} queries"
         );
     }

@@ -9,7 +9,7 @@
 use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Vector;
 
-use crate::centreline::{Centreline, CentrelinePoint};
+use crate::centreline::{Centreline, CentrelinePoint, CircularArc};
 use crate::contact::{LocalContact, unit};
 
 /// One piece of a tube centreline as declared: it continues from where the
@@ -299,6 +299,32 @@ impl Centreline for TubeInterior {
     fn past_end(&self, q: Vector) -> Option<f64> {
         let (e, out) = self.nearer_end(q);
         Some((q - e).dot(out))
+    }
+
+    /// A tube of one arc segment of at most π (the paper's bend). Its end
+    /// planes pass through the circle's centre, so a point whose direction
+    /// lies within the angle is before both, and its nearest point is the
+    /// arc's ([`TubeInterior::nearest`]).
+    fn arc(&self) -> Option<CircularArc> {
+        match self.segments.as_slice() {
+            [
+                Segment::Arc {
+                    center,
+                    radius,
+                    u,
+                    t,
+                    angle,
+                    end,
+                },
+            ] if *angle <= std::f64::consts::PI => Some(CircularArc {
+                centre: *center,
+                radius: *radius,
+                u: *u,
+                t: *t,
+                end: *end,
+            }),
+            _ => None,
+        }
     }
 }
 
