@@ -186,8 +186,10 @@ impl<L: Centreline + ?Sized> RodInLumen<'_, L> {
     /// open ends.
     fn axis_at(&self, s: f64) -> Option<(Vector, Vector, Axis)> {
         let q = self.rod.at(s);
-        if let Some(((c, sn), axis)) = self.on_arc.as_ref().and_then(|on| on.at(s)) {
-            let arc = &self.on_arc.as_ref()?.arc;
+        if let Some(on) = &self.on_arc
+            && let Some(((c, sn), axis)) = on.at(s)
+        {
+            let arc = &on.arc;
             let u = q - (arc.centre + arc.radius * (c * arc.u + sn * arc.t));
             return Some((q, u, axis));
         }
