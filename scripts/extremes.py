@@ -8,7 +8,8 @@ default with the shipped setting (ESDIRK3(2), adaptive at rtol 1e-4, frames
 within steps interpolated); `--integrator sdirk2 --rtol 0` runs them at SDIRK2's fixed 100 µs. Prints a markdown table:
 whether the run finished, its CPU time [s], Newton iterations per stage,
 rejected steps, step halvings and first-order fallback part steps.
-Takes 5–10 minutes on this project's machine.
+Takes about 1 to 2 minutes on this project's machine (1 min 11 s on
+2026-11-27; 5–10 minutes before the adaptive default).
 """
 
 from __future__ import annotations
