@@ -1078,6 +1078,41 @@ mod tests {
         )
     }
 
+    /// A seeded generator of uniform numbers in [0, 1) (Knuth's MMIX
+    /// constants), so that the random poses of the tests are always the same.
+    struct Lcg(u64);
+
+    impl Lcg {
+        fn uniform(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+
+        fn vector(&mut self) -> Vector {
+            Vector::new(
+                self.uniform() - 0.5,
+                self.uniform() - 0.5,
+                self.uniform() - 0.5,
+            )
+        }
+    }
+
+    /// A link ([`rod`]) whose centre is up to 17 mm off the centreline
+    /// point `along` [m] of `arc` (continued straight past its ends), in a
+    /// random direction across it, its axis tilted from the tangent by up
+    /// to about 6°.
+    fn link_near(arc: &TubeInterior, along: f64, rng: &mut Lcg) -> Rod {
+        let on = along.clamp(0.0, arc.length());
+        let c = arc.point_at(on);
+        let across = unit(c.tangent.cross(rng.vector()));
+        let tilt = unit(rng.vector());
+        let centre = c.point + (along - on) * c.tangent + (0.017 * rng.uniform()) * across;
+        rod(centre, unit(c.tangent + 0.1 * rng.uniform() * tilt))
+    }
+
     fn rod(centre: Vector, axis: Vector) -> Rod {
         Rod {
             centre,
@@ -1302,26 +1337,12 @@ mod tests {
     fn the_closed_form_along_an_arc_matches_the_nearest_point_queries() {
         let arc = crate::tube::tests::paper_tube();
         assert!(arc.arc().is_some() && Generic(&arc).arc().is_none());
-        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
-        let mut uniform = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Lcg(0x2545_f491_4f6c_dd1d);
         let (mut compared, mut crossing) = (0, 0);
         for case in 0..3000 {
             // Centres from 0.15 m before the entry to 0.15 m past the exit.
-            let along = -0.15 + (arc.length() + 0.3) * uniform();
-            let c = arc.point_at(along.clamp(0.0, arc.length()));
-            let centre = c.point + (along - along.clamp(0.0, arc.length())) * c.tangent;
-            let mut random = || Vector::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
-            let across = unit(c.tangent.cross(random()));
-            let tilt = unit(random());
-            let r = rod(
-                centre + (0.017 * uniform()) * across,
-                unit(c.tangent + 0.1 * uniform() * tilt),
-            );
+            let along = -0.15 + (arc.length() + 0.3) * rng.uniform();
+            let r = link_near(&arc, along, &mut rng);
             let ends = if case % 2 == 0 {
                 Ends::Flat
             } else {
@@ -1412,21 +1433,10 @@ mod tests {
             tube: &arc,
             queries: std::cell::Cell::new(0),
         };
-        let mut seed = 0x1234_5678_9abc_def1_u64;
-        let mut uniform = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Lcg(0x1234_5678_9abc_def1);
         let (mut roots, mut queries, mut worst) = (0, 0, 0.0_f64);
         for _ in 0..2000 {
-            let c = arc.point_at(0.2 + 2.0 * uniform());
-            let mut random = || Vector::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
-            let across = unit(c.tangent.cross(random()));
-            let tilt = unit(random());
-            let centre = c.point + (0.017 * uniform()) * across;
-            let r = rod(centre, unit(c.tangent + 0.1 * uniform() * tilt));
+            let r = link_near(&arc, 0.2 + 2.0 * rng.uniform(), &mut rng);
             let link = RodInLumen::new(&lumen, r, Ends::Round, false);
             let s = |k: usize| -0.1 + 0.05 * k as f64;
             for k in 0..4 {
@@ -1483,7 +1493,8 @@ mod tests {
     /// changes no reported contact by a single bit, on 4000 poses of a link
     /// in the paper's arc, each end type, 5 and 33 samples (links from
     /// touch-free to 2 mm deep, tilted up to 6°); and it does skip work
-    /// (9 % of the nearest-point queries here).
+    /// (3.8 % of the nearest-point queries here; 9 % before the roots took
+    /// about two queries each, docs/performance.md change 15).
     #[test]
     fn culled_brackets_change_no_contact_bit_for_bit() {
         let arc = crate::tube::tests::paper_tube();
@@ -1491,21 +1502,10 @@ mod tests {
             tube: &arc,
             queries: std::cell::Cell::new(0),
         };
-        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut uniform = || {
-            seed = seed
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Lcg(0x9e37_79b9_7f4a_7c15);
         let (mut with, mut without, mut touching) = (0, 0, 0);
         for case in 0..4000 {
-            let c = arc.point_at(0.2 + 2.0 * uniform());
-            let mut random = || Vector::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
-            let across = unit(c.tangent.cross(random()));
-            let tilt = unit(random());
-            let centre = c.point + (0.017 * uniform()) * across;
-            let r = rod(centre, unit(c.tangent + 0.1 * uniform() * tilt));
+            let r = link_near(&arc, 0.2 + 2.0 * rng.uniform(), &mut rng);
             let ends = if case % 2 == 0 {
                 Ends::Flat
             } else {
