@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from pathlib import Path
 
 import ballcage
 from ballcage.studies.common import newton_per_stage
@@ -53,7 +54,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--integrator", default=None, help="simulation.integrator (default: the scene's)")
     parser.add_argument("--rtol", type=float, default=None, help="simulation.rtol (0: fixed steps of simulation.dt)")
-    parser.add_argument("--out", default="extremes.json", help="where the raw results go")
+    parser.add_argument("--out", default="out/extremes.json", help="where the raw results go (out/ is not tracked)")
     args = parser.parse_args()
     base = [] if args.integrator is None else [f'simulation.integrator="{args.integrator}"']
     if args.rtol is not None:
@@ -62,6 +63,7 @@ def main() -> None:
     for name, overrides in EXTREMES.items():
         results[name] = one([*base, *overrides])
         print(f"{name}: {results[name]['finished']}, {results[name]['cpu_s']:.1f} s", flush=True)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w") as f:
         json.dump(results, f, indent=1)
     print("\n| case | finished | CPU [s] | Newton its/stage | rejected | halvings | fallbacks |")

@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from pathlib import Path
 
 import ballcage
 from ballcage.studies.common import newton_per_stage
@@ -75,7 +76,7 @@ def largest_difference(run: dict, reference: dict) -> tuple[float, str]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--duration", type=float, default=1.8, help="simulated time [s] (default 1.8)")
-    parser.add_argument("--out", default="work_precision.json", help="where the raw results go")
+    parser.add_argument("--out", default="out/work_precision.json", help="where the raw results go (out/ is not tracked)")
     parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE[;KEY=VALUE]",
                         help="one more row: the default with these overrides (repeatable)")
     args = parser.parse_args()
@@ -84,6 +85,7 @@ def main() -> None:
     for name, overrides in cases.items():
         results[name] = measure(overrides, args.duration)
         print(f"{name}: {results[name]['cpu_s']:.1f} s", flush=True)
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     with open(args.out, "w") as f:
         json.dump(results, f, indent=1)
     reference = results["SDIRK2 25 µs (reference)"]
