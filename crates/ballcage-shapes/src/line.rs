@@ -1164,13 +1164,26 @@ mod tests {
         }
     }
 
-    /// (depth, kind) of every extremum, in axial order.
-    fn extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum)> {
+    /// [`line_extrema`] at `samples`: every contact and its kind, in axial
+    /// order, and the length inside an open end (measured below 0.1 m,
+    /// which changes no contact).
+    fn extrema_inside<L: Centreline>(
+        lumen: &L,
+        r: &Rod,
+        ends: Ends,
+        samples: u32,
+    ) -> (Vec<(LocalContact, Extremum)>, Option<f64>) {
         let mut out = vec![];
-        line_extrema(lumen, r, Ends::Flat, samples, (0.0, 0.0), &mut |c, kind| {
-            out.push((c.depth, kind))
+        let inside = line_extrema(lumen, r, ends, samples, (0.0, 0.1), &mut |c, kind| {
+            out.push((c, kind))
         });
-        out
+        (out, inside)
+    }
+
+    /// (depth, kind) of every extremum of a flat-ended rod, in axial order.
+    fn extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum)> {
+        let (found, _) = extrema_inside(lumen, r, Ends::Flat, samples);
+        found.into_iter().map(|(c, kind)| (c.depth, kind)).collect()
     }
 
     #[test]
@@ -1274,17 +1287,26 @@ mod tests {
 
     /// (depth, kind, feature) of every extremum, in axial order.
     fn all_extrema(lumen: &TubeInterior, r: &Rod, samples: u32) -> Vec<(f64, Extremum, u32)> {
-        let mut out = vec![];
-        line_extrema(lumen, r, Ends::Flat, samples, (0.0, 0.0), &mut |c, kind| {
-            out.push((c.depth, kind, c.feature))
-        });
-        out
+        let (found, _) = extrema_inside(lumen, r, Ends::Flat, samples);
+        found
+            .into_iter()
+            .map(|(c, kind)| (c.depth, kind, c.feature))
+            .collect()
     }
 
     /// A centreline that counts its nearest-point queries.
     struct Counting<'a> {
         tube: &'a TubeInterior,
         queries: std::cell::Cell<u64>,
+    }
+
+    impl<'a> Counting<'a> {
+        fn new(tube: &'a TubeInterior) -> Self {
+            Self {
+                tube,
+                queries: std::cell::Cell::new(0),
+            }
+        }
     }
 
     impl Centreline for Counting<'_> {
@@ -1313,20 +1335,6 @@ mod tests {
         }
     }
 
-    /// [`line_extrema`] at 5 samples, every contact and its kind, and the
-    /// length inside an open end (measured below 0.1 m).
-    fn extrema_inside<L: Centreline>(
-        lumen: &L,
-        r: &Rod,
-        ends: Ends,
-    ) -> (Vec<(LocalContact, Extremum)>, Option<f64>) {
-        let mut out = vec![];
-        let inside = line_extrema(lumen, r, ends, 5, (0.0, 0.1), &mut |c, kind| {
-            out.push((c, kind))
-        });
-        (out, inside)
-    }
-
     /// The closed form along an arc ([`AxisOnArc`]) finds the extrema the
     /// nearest-point queries find: the same contacts, kinds and features,
     /// depths within 1e-15 m, points within 1e-11 m, normals within 1e-11,
@@ -1348,8 +1356,8 @@ mod tests {
             } else {
                 Ends::Round
             };
-            let (fast, fast_inside) = extrema_inside(&arc, &r, ends);
-            let (slow, slow_inside) = extrema_inside(&Generic(&arc), &r, ends);
+            let (fast, fast_inside) = extrema_inside(&arc, &r, ends, 5);
+            let (slow, slow_inside) = extrema_inside(&Generic(&arc), &r, ends, 5);
             assert_eq!(fast.len(), slow.len(), "case {case}");
             assert_eq!(fast_inside.is_some(), slow_inside.is_some(), "case {case}");
             if let (Some(a), Some(b)) = (fast_inside, slow_inside) {
@@ -1429,10 +1437,7 @@ mod tests {
     #[test]
     fn a_root_between_samples_costs_few_queries_and_is_exact() {
         let arc = crate::tube::tests::paper_tube();
-        let lumen = Counting {
-            tube: &arc,
-            queries: std::cell::Cell::new(0),
-        };
+        let lumen = Counting::new(&arc);
         let mut rng = Lcg(0x1234_5678_9abc_def1);
         let (mut roots, mut queries, mut worst) = (0, 0, 0.0_f64);
         for _ in 0..2000 {
@@ -1498,10 +1503,7 @@ mod tests {
     #[test]
     fn culled_brackets_change_no_contact_bit_for_bit() {
         let arc = crate::tube::tests::paper_tube();
-        let lumen = Counting {
-            tube: &arc,
-            queries: std::cell::Cell::new(0),
-        };
+        let lumen = Counting::new(&arc);
         let mut rng = Lcg(0x9e37_79b9_7f4a_7c15);
         let (mut with, mut without, mut touching) = (0, 0, 0);
         for case in 0..4000 {
