@@ -138,14 +138,19 @@ def test_rank_bends_reads_the_bend_from_the_links_included_angle():
 
 
 def _profile_links() -> dict[str, list]:
-    """Four links over 13 frames: mean tube forces 0, 900, 1000, 450 N at inclinations 10, 30, 50, 70 deg."""
+    """Four links over 13 frames: mean tube forces 0, 900, 1000, 450 N at inclinations 10, 30, 50, 70 deg.
+
+    The frames' forces swing +-100 N about the mean; the impulse columns (the engine's integral over its own
+    steps) grow at the mean, so the time mean is the mean whatever the frames show.
+    """
     means = {1: 0.0, 2: 900.0, 3: 1000.0, 4: 450.0}
-    cols: dict[str, list] = {c: [] for c in ("t", "link", "tube_normal", "tube_tangential", "inclination_deg")}
+    names = ("t", "link", "tube_normal", "tube_tangential", "inclination_deg", "tube_normal_impulse", "tube_tangential_impulse")
+    cols: dict[str, list] = {c: [] for c in names}
     for f, t in enumerate(TIMES):
         for k, mean in means.items():
-            swing = 100.0 if (f % 2 and mean) else (-100.0 if mean else 0.0)  # +-100 N about the mean, mean kept
-            swing *= 0.0 if f == len(TIMES) - 1 else 1.0
-            for name, v in zip(cols, (t, k, mean + swing, 0.1 * mean, 20.0 * k - 10.0 + (1.0 if f % 2 else -1.0))):
+            swing = 100.0 if (f % 2 and mean) else (-100.0 if mean else 0.0)
+            incl = 20.0 * k - 10.0 + (1.0 if f % 2 else -1.0)
+            for name, v in zip(cols, (t, k, mean + swing, 0.1 * mean, incl, mean * t, 0.1 * mean * t)):
                 cols[name].append(v)
     return cols
 

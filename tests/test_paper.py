@@ -362,8 +362,9 @@ def test_shape_offsets_agree_with_the_native_radial_offset(short_run):
 
 def test_link_tube_forces_agree_with_the_summary_of_the_tube_pairs():
     # A 3-joint pipe comes to rest on the tube from about 0.13 s. links.tube_normal / tube_tangential are the
-    # per-frame totals of each link's contact with the tube, so over the summary window their mean and peak are
-    # the summary's for that pair (the pair name is formatted here only to find its summary row).
+    # per-frame totals of each link's contact with the tube and links.tube_*_impulse their integrals, so over the
+    # summary window their peak and time mean are the summary's for that pair (the pair name is formatted here
+    # only to find its summary row).
     start, end = 0.1, 0.2
     scene = paper.paper_scene(
         ["pipe.joints=3", f"simulation.duration={end}", "simulation.output_interval=0.005",
@@ -377,6 +378,7 @@ def test_link_tube_forces_agree_with_the_summary_of_the_tube_pairs():
     link = links.column("link").to_numpy()
     normal = links.column("tube_normal").to_numpy()
     tangential = links.column("tube_tangential").to_numpy()
+    impulse = {kind: links.column(f"tube_{kind}_impulse").to_numpy() for kind in ("normal", "tangential")}
     assert normal[inside].max() > 100.0  # the chain rests on the tube [N]
     assert (normal[~inside] == 0.0).any()  # and did not at the start
     found = studies.quantities(run)
@@ -384,9 +386,12 @@ def test_link_tube_forces_agree_with_the_summary_of_the_tube_pairs():
         row = summary[f"link{k:02d}/tube"]
         mask = inside & (link == k)
         assert mask.sum() == row["frames"], k
-        assert normal[mask].mean() == pytest.approx(row["normal_mean"], rel=1e-9), k
+        span = t[mask].max() - t[mask].min()
+        for kind in ("normal", "tangential"):
+            growth = impulse[kind][mask].max() - impulse[kind][mask].min()  # the integrals do not decrease
+            assert growth / span == pytest.approx(row[f"{kind}_mean"], rel=1e-9), (k, kind)
         assert normal[mask].max() == pytest.approx(row["normal_peak"], rel=1e-9), k
-        assert tangential[mask].mean() == pytest.approx(row["tangential_mean"], rel=1e-9), k
+        assert tangential[mask].max() == pytest.approx(row["tangential_peak"], rel=1e-9), k
         assert found[f"tube_mean_force_joint_{k:02d}"].value == pytest.approx(row["normal_mean"], rel=1e-9), k
     rows = {r["key"]: r for r in paper.comparison(run).to_pylist()}
     for kind in ("normal", "tangential"):

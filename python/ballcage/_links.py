@@ -4,6 +4,15 @@ The window is the scene's ``record.summary_window`` (the whole run when it is
 not set) with the summary table's semantics: the frames with
 ``window_start - 1e-12 <= t <= window_end + 1e-12``; a frame without contact
 counts as 0 N, which ``links.tube_normal`` already is.
+
+A mean is a mean over time, not over the frames: the difference of the link's
+cumulative impulse (``links.tube_normal_impulse``, ``tube_tangential_impulse``
+[N*s], which the integrator accumulates over its own steps) between the
+window's ends, over the window's length. It therefore does not depend on
+``simulation.output_interval`` (docs/accuracy.md, "A mean force is a mean over
+time"). A ``links`` table without those columns (written before they existed)
+gives the impulse by the trapezoid rule over its frames. Peaks are the largest
+value at a frame.
 """
 
 from __future__ import annotations
@@ -16,7 +25,7 @@ import numpy as np
 from ballcage import _native
 from ballcage.run import Run
 
-__all__ = ["LinkTubeForces", "in_summary_window", "link_tube_forces", "summary_window"]
+__all__ = ["LinkTubeForces", "in_summary_window", "link_tube_forces", "summary_window", "time_mean"]
 
 #: Slack [s] on the window's ends, as the engine's summary table applies it.
 WINDOW_SLACK = 1e-12
@@ -29,9 +38,9 @@ class LinkTubeForces:
     start: float  # first time of the window [s]
     end: float  # last time of the window, at most the last frame [s]
     frames: int  # frames in the window
-    normal_mean: dict[int, float]  # mean of links.tube_normal [N]
-    normal_peak: dict[int, float]  # largest links.tube_normal [N]
-    tangential_mean: dict[int, float]  # mean of links.tube_tangential [N]
+    normal_mean: dict[int, float]  # time mean of links.tube_normal [N]
+    normal_peak: dict[int, float]  # largest links.tube_normal at a frame [N]
+    tangential_mean: dict[int, float]  # time mean of links.tube_tangential [N]
 
 
 def summary_window(scene: _native.Scene) -> tuple[float, float]:
@@ -59,14 +68,42 @@ def link_tube_forces(run: Run) -> LinkTubeForces | None:
     link = links.column("link").to_numpy()
     normal = links.column("tube_normal").to_numpy()
     tangential = links.column("tube_tangential").to_numpy()
+    integrals = {
+        name: links.column(name).to_numpy() if name in links.column_names else None
+        for name in ("tube_normal_impulse", "tube_tangential_impulse")
+    }
     normal_mean: dict[int, float] = {}
     normal_peak: dict[int, float] = {}
     tangential_mean: dict[int, float] = {}
     for k in sorted(int(k) for k in np.unique(link)):
-        mask = inside & (link == k)
-        found = bool(mask.any())
-        normal_mean[k] = float(normal[mask].mean()) if found else 0.0
-        normal_peak[k] = float(normal[mask].max()) if found else 0.0
-        tangential_mean[k] = float(tangential[mask].mean()) if found else 0.0
+        rows = np.flatnonzero(link == k)
+        rows = rows[np.argsort(t[rows], kind="stable")]
+        mask = inside[rows]
+        if not mask.any():
+            normal_mean[k] = normal_peak[k] = tangential_mean[k] = 0.0
+            continue
+        normal_peak[k] = float(normal[rows][mask].max())
+        for out, value, integral in (
+            (normal_mean, normal, integrals["tube_normal_impulse"]),
+            (tangential_mean, tangential, integrals["tube_tangential_impulse"]),
+        ):
+            out[k] = time_mean(t[rows], value[rows], None if integral is None else integral[rows], mask)
     frames = int(np.unique(t[inside]).size)
     return LinkTubeForces(start, min(end, float(t.max())), frames, normal_mean, normal_peak, tangential_mean)
+
+
+def time_mean(t: np.ndarray, value: np.ndarray, impulse: np.ndarray | None, inside: np.ndarray) -> float:
+    """The time mean of `value` over the frames `inside` (a window of frames at ascending times `t` [s]).
+
+    ``(I(b) - I(a)) / (b - a)``, `a` and `b` the first and last time inside, `I` the cumulative `impulse`
+    (the integrator's) or, without it, the trapezoid rule over the frames; a window of one frame is that
+    frame's value.
+    """
+    times = t[inside]
+    a, b = float(times[0]), float(times[-1])
+    if b - a <= 0.0:
+        return float(value[inside].mean())
+    if impulse is None:
+        impulse = np.concatenate(([0.0], np.cumsum(0.5 * (value[1:] + value[:-1]) * np.diff(t))))
+    cumulative = impulse[inside]
+    return float((cumulative[-1] - cumulative[0]) / (b - a))

@@ -13,9 +13,11 @@ use crate::force::joint::twist_axis;
 use crate::geometry::{CentreMotion, ContactPoint, PointSink, Rim, Slide};
 use crate::math::{Mat3, Vec3};
 use crate::model::{ContactPair, Joint, Model, Motion, State};
+pub use impulse::{Impulses, PairTotals};
 use nalgebra::Vector6;
 use table::{ContactTable, PairSlots};
 
+mod impulse;
 mod table;
 
 /// Accelerations of every body (zero for bodies that are not integrated).
@@ -181,6 +183,9 @@ pub struct Dynamics {
     pub evaluations: u64,
     /// Deepest penetration and stiffest contact since the last reset.
     pub watch: ContactWatch,
+    /// Each pair's impulse as the integrator applied it, when a table
+    /// records it ([`Dynamics::track_impulses`]).
+    impulses: Option<Impulses>,
 }
 
 /// What the contact points evaluated since the last
@@ -310,6 +315,7 @@ impl Dynamics {
             kept_valid: false,
             evaluations: 0,
             watch: ContactWatch::default(),
+            impulses: None,
         }
     }
 
@@ -454,6 +460,54 @@ impl Dynamics {
         self.wrenches(model, state, Mode::Trial);
         state.copy_into(&mut self.kept);
         self.kept_valid = true;
+    }
+
+    /// Integrates each pair's impulse from now on ([`Impulses`]): the
+    /// integrators then keep every stage's pair totals.
+    pub fn track_impulses(&mut self, model: &Model) {
+        self.impulses = Some(Impulses::new(model.pairs.len()));
+    }
+
+    /// Each pair's cumulative impulse [N·s] at `t` [s] into `out`
+    /// ([`Impulses::at`]); empty when not tracked.
+    pub fn impulses_at(&self, t: f64, out: &mut Vec<PairTotals>) {
+        match &self.impulses {
+            Some(i) => i.at(t, out),
+            None => out.clear(),
+        }
+    }
+
+    /// The last evaluation was stage `s`'s last ([`Impulses::take_stage`]).
+    pub(crate) fn note_stage(&mut self, s: usize) {
+        if let Some(i) = &mut self.impulses {
+            i.take_stage(s, &self.table);
+        }
+    }
+
+    /// A step with nothing to integrate (only prescribed bodies move)
+    /// starts at `state`: when impulses are tracked, the forces there are
+    /// every stage's (the impulse is the start's force times the step).
+    pub(crate) fn note_unintegrated(&mut self, model: &Model, state: &State) {
+        if self.impulses.is_some() {
+            self.wrenches(model, state, Mode::Trial);
+            for s in 0..impulse::STAGES {
+                self.note_stage(s);
+            }
+        }
+    }
+
+    /// Stage `to` has stage `from`'s forces ([`Impulses::copy_stage`]).
+    pub(crate) fn note_same_stage(&mut self, from: usize, to: usize) {
+        if let Some(i) = &mut self.impulses {
+            i.copy_stage(from, to);
+        }
+    }
+
+    /// A step of `h` [s] from `t0` [s] was accepted ([`Impulses::accept`]).
+    pub(crate) fn note_accepted(&mut self, t0: f64, h: f64, weights: &[(usize, f64)], last: usize) {
+        if let Some(i) = &mut self.impulses {
+            i.accept(t0, h, weights, last);
+        }
     }
 
     /// Whether the last evaluation was [`Dynamics::wrenches_kept`] at

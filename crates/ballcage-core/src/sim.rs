@@ -121,6 +121,9 @@ impl Simulation {
         let mut dynamics = Dynamics::new(&model);
         let workspace = Workspace::new(&state);
         let mut recorder = Recorder::new(&model, observers);
+        if recorder.needs_impulses() {
+            dynamics.track_impulses(&model);
+        }
         recorder.record(&model, &state, 0, &mut dynamics, (0.0, 0.0));
         let initial_deepest = deepest_penetration(&model, &state, &mut dynamics);
         let e0 = dynamics.energy(&model, &state);

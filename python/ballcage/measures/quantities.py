@@ -103,11 +103,11 @@ MEASURES: dict[str, str] = {
         "links.tube_normal (tube_normal_mean_max_n): where along the chain the tube force is largest"
     ),
     "tube_normal_mean_all_n": (
-        "differs: ours is the SUM over links 1-12 of the mean links.tube_normal over the summary window "
+        "differs: ours is the SUM over links 1-12 of the time mean of links.tube_normal over the summary window "
         "(reading 1: a sum, the only reading that can exceed a single joint's peak)"
     ),
     "tube_tangential_mean_all_n": (
-        "differs: ours is the SUM over links 1-12 of the mean links.tube_tangential over the summary window "
+        "differs: ours is the SUM over links 1-12 of the time mean of links.tube_tangential over the summary window "
         "(magnitude of the per-frame summed friction vector; reading 1: a sum)"
     ),
     "seat_cage_normal_peak_n": "maximum of hinges.cage_seat_normal (ball seat-ball cage) over all hinges and frames",
@@ -147,7 +147,7 @@ _UNITS: dict[str, str] = {
 _EXTRA: dict[str, tuple[str, str]] = {
     "tube_normal_mean_max_n": (
         "N",
-        "largest per-link mean of links.tube_normal over the summary window (the paper's sweep quantity tube_mean_max)",
+        "largest per-link time mean of links.tube_normal over the summary window (the paper's sweep quantity tube_mean_max)",
     ),
     "tube_normal_peak_max_n": ("N", "largest links.tube_normal of any link and frame of the summary window"),
     "key_peak_n": (
@@ -182,7 +182,7 @@ _LINK_MEAN = re.compile(r"tube_normal_mean_link_(\d+)_n")
 def link_columns(link: int) -> dict[str, tuple[str, str]]:
     """The two per-link columns of link `link` (1 at the top): mean and peak tube normal force [N]."""
     return {
-        f"tube_normal_mean_link_{link:02d}_n": ("N", f"mean of links.tube_normal of link {link} over the summary window"),
+        f"tube_normal_mean_link_{link:02d}_n": ("N", f"time mean of links.tube_normal of link {link} over the summary window"),
         f"tube_normal_peak_link_{link:02d}_n": ("N", f"largest links.tube_normal of link {link} over the summary window"),
     }
 

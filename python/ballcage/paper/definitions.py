@@ -137,16 +137,16 @@ DEFINITIONS: dict[str, str] = {
         "over the frames of the summary window"
     ),
     "tube_normal_mean_joint10_n": (
-        "ours: mean of links.tube_normal of link 10 over the frames of the summary window (frames without "
-        "contact count as 0)"
+        "ours: time mean of links.tube_normal of link 10 over the summary window (its impulse "
+        "links.tube_normal_impulse over the window's length; no contact counts as 0)"
     ),
-    "tube_normal_mean_joint12_n": "ours: mean of links.tube_normal of link 12 over the frames of the summary window",
+    "tube_normal_mean_joint12_n": "ours: time mean of links.tube_normal of link 12 over the summary window",
     "tube_normal_mean_max_inclination_deg": _ours("tube_normal_mean_max_inclination_deg"),
     **{key: _ours(key) for key in _SUMS_AND_PEAKS},
 }
 SWEEP_DEFINITIONS: dict[str, str] = {
     "tube_mean_max": (
-        "ours: largest per-link mean of links.tube_normal over the summary window of the {label} variant"
+        "ours: largest per-link time mean of links.tube_normal over the summary window of the {label} variant"
     ),
     "key_peak": (
         "differs: ours is the maximum race normal force on one key, max of keys.inner_normal and "

@@ -14,8 +14,8 @@ Quantities (`quantities`), each a scalar per run:
 
 - drill-pipe scenes: ``key_seat_normal_peak`` (largest keys.outer_normal,
   seat race, both flanks of one key summed, over all keys and frames [N]),
-  ``tube_mean_force_joint_NN`` (mean of links.tube_normal of link NN over
-  the summary window's frames [N]),
+  ``tube_mean_force_joint_NN`` (time mean of links.tube_normal of link NN
+  over the summary window, from links.tube_normal_impulse [N]),
   ``final_bend_deg_link_NN`` (180° − links.included_angle_deg of link NN at
   the last frame [deg]);
 - generic scenes: ``peak_normal_force_<pair>`` (summary.normal_peak [N]),

@@ -101,7 +101,7 @@ def _tube_quantities(run: Run) -> dict[str, Quantity]:
         return {}
     return {
         f"tube_mean_force_joint_{link:02d}": _scalar(
-            "force", mean, f"mean of links.tube_normal of link {link:02d} over the summary window"
+            "force", mean, f"time mean of links.tube_normal of link {link:02d} over the summary window"
         )
         for link, mean in tube.normal_mean.items()
     }

@@ -86,6 +86,18 @@ const LINKS_COLUMNS: &[ColumnDef] = &[
         "Pa",
         "Hertz peak pressure p₀ of the link's most loaded tube contact: a line along the wall, an elliptical patch at a rim rounded to pipe.link_edge_radius; 0 without contact",
     ),
+    col(
+        "tube_normal_impulse",
+        F64,
+        "N*s",
+        "integral of tube_normal from t = 0 to the frame, as the integrator applied it over its own steps (interpolated within an adaptive step); a mean over [a, b] is the difference over b - a",
+    ),
+    col(
+        "tube_tangential_impulse",
+        F64,
+        "N*s",
+        "integral of tube_tangential from t = 0 to the frame, as tube_normal_impulse",
+    ),
 ];
 
 /// Columns of the `hinges` table (drill pipe): one row per hinge per frame.
@@ -464,6 +476,10 @@ impl Observer for PipeTables {
         !self.wear.is_empty()
     }
 
+    fn needs_impulses(&self) -> bool {
+        self.tables.contains(&PipeTable::Links)
+    }
+
     fn step(&mut self, step: &Step<'_>) {
         let t = step.state.t;
         let (start, end) = self.window;
@@ -561,8 +577,16 @@ fn links(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Fr
             Cell::F64(tube_n),
             Cell::F64(tube_t),
             Cell::F64(peak_pressure(stress, f, tube)),
+            Cell::F64(impulse(f, tube, 0)),
+            Cell::F64(impulse(f, tube, 1)),
         ]);
     }
+}
+
+/// The summed impulse [N·s] of the pairs `pairs`: normal (`i` = 0) or
+/// friction (`i` = 1), [`Frame::impulses`].
+fn impulse(f: &Frame<'_>, pairs: &[usize], i: usize) -> f64 {
+    pairs.iter().map(|&k| f.impulses[k][i]).sum()
 }
 
 fn hinges(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Frame<'_>) {

@@ -55,6 +55,9 @@ const A: [[f64; 4]; 4] = [
     [B[0], B[1], B[2], GAMMA],
 ];
 
+/// Each stage's weight b_j, for [`Dynamics::note_accepted`].
+const STAGE_WEIGHTS: [(usize, f64); 4] = [(0, B[0]), (1, B[1]), (2, B[2]), (3, B[3])];
+
 /// The weights b of the third-order solution (= the last row of A).
 const B: [f64; 4] = [
     0.187_641_024_346_723_83,
@@ -297,6 +300,7 @@ impl Implicit {
                     let err = self.error_norm(model, &saved, &cur, tol);
                     if self.control(h, proposed, err) {
                         self.keep_dense(&saved, h, false);
+                        dynamics.note_accepted(saved.t, h, &STAGE_WEIGHTS, 3);
                         Ok(())
                     } else {
                         cur.clone_from(&saved);
@@ -492,6 +496,10 @@ impl Implicit {
         h: f64,
     ) -> Result<(), StageFailure> {
         if self.n == 0 {
+            dynamics.note_unintegrated(model, state);
+            if model.tolerance.is_none() {
+                dynamics.note_accepted(state.t, h, &STAGE_WEIGHTS, 3);
+            }
             state.t += h;
             model.prescribe(state.t, state);
             return Ok(());
@@ -517,6 +525,7 @@ impl Implicit {
                     break;
                 }
             }
+            dynamics.note_stage(s);
             self.finish_stage(s, h);
         }
         self.refresh = result.is_err() || worst > model.newton.reuse_iterations;
@@ -531,6 +540,7 @@ impl Implicit {
             state.copy_into(&mut es.known_end);
             if model.tolerance.is_none() {
                 self.note_accepted(h);
+                dynamics.note_accepted(state.t - h, h, &STAGE_WEIGHTS, 3);
             }
         }
         self.stage = Some(stage);
@@ -551,8 +561,10 @@ impl Implicit {
         let at = |kept: &Option<State>| kept.as_ref().is_some_and(|k| k.is_at(state, 1e-9 * h));
         if !memory && at(&es.known_end) {
             es.acc[0].copy_from_slice(&es.end_acc);
+            dynamics.note_same_stage(3, 0);
         } else if memory || !at(&es.known_start) {
             self.explicit_stage(model, dynamics, state);
+            dynamics.note_stage(0);
         }
         self.gather(model, state);
         let es = self.esdirk.as_mut().expect("made by esdirk_step");

@@ -471,6 +471,10 @@ impl Implicit {
         h: f64,
     ) {
         dynamics.forces_and_jacobian(model, state, Mode::Commit, 0.0, &mut self.jac);
+        // The step applies the start's forces plus their linear change,
+        // whose share per pair is not known: the impulse counts the start's.
+        dynamics.note_stage(0);
+        dynamics.note_accepted(state.t, h, &[(0, 1.0)], 0);
         self.assemble_matrix(model, state, h);
         self.euler_rhs(model, dynamics, state, h);
         let solved = self.factor() && self.solve();
@@ -565,6 +569,8 @@ impl Implicit {
     ) -> Result<(), StageFailure> {
         if self.n == 0 {
             // Nothing to integrate: only the prescribed bodies move.
+            dynamics.note_unintegrated(model, state);
+            dynamics.note_accepted(state.t, h, &[(0, 1.0 - GAMMA), (1, GAMMA)], 1);
             state.t += h;
             model.prescribe(state.t, state);
             return Ok(());
@@ -599,9 +605,11 @@ impl Implicit {
                     break;
                 }
             }
+            dynamics.note_stage(s);
         }
         self.refresh = result.is_err() || worst > model.newton.reuse_iterations;
         if result.is_ok() {
+            dynamics.note_accepted(state.t, h, &[(0, 1.0 - GAMMA), (1, GAMMA)], 1);
             std::mem::swap(state, &mut stage);
             state.t = stage.t + h;
             model.prescribe(state.t, state);

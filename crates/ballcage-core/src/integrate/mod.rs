@@ -122,6 +122,8 @@ fn symplectic_euler(
 ) {
     let acc = &mut ws.acc[0];
     dynamics.accelerations(model, state, Mode::Commit, acc);
+    dynamics.note_stage(0);
+    dynamics.note_accepted(state.t, h, &[(0, 1.0)], 0);
     for &i in &model.integrated {
         state.vel[i] += h * acc.lin[i];
         state.omega[i] += h * acc.ang[i];
@@ -165,7 +167,9 @@ fn rk4(model: &Model, dynamics: &mut Dynamics, ws: &mut Workspace, state: &mut S
         }
         let mode = if s == 0 { Mode::Commit } else { Mode::Trial };
         dynamics.accelerations(model, stage, mode, &mut acc[s]);
+        dynamics.note_stage(s);
     }
+    dynamics.note_accepted(state.t, h, &[(0, W[0]), (1, W[1]), (2, W[2]), (3, W[3])], 3);
     for &i in &model.integrated {
         let mut dx = Vec3::zeros();
         let mut dv = Vec3::zeros();

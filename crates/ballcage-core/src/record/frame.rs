@@ -7,7 +7,7 @@
 use std::ops::Range;
 
 use super::{BodyParts, Cell, Frame, Observer, Step, TableBuffer, contact_totals, table_def};
-use crate::dynamics::{ContactEval, Dynamics, Energy};
+use crate::dynamics::{ContactEval, Dynamics, Energy, PairTotals};
 use crate::model::{Model, State};
 use crate::scene::TableKind;
 
@@ -21,10 +21,38 @@ struct PairStats {
     tangential_peak: f64,
     tangential_sum: f64,
     tangential_squares: SumOfSquares,
+    /// The pair's impulses at the first and the last frame of the window:
+    /// (t [s], [normal, friction] [N·s]).
+    first: Option<(f64, PairTotals)>,
+    last: (f64, PairTotals),
 }
 
 impl PairStats {
-    fn add(&mut self, (n, t): (f64, f64)) {
+    /// The time means of the normal force and of the friction force's
+    /// magnitude [N]: the impulses' growth between the window's first and
+    /// last frames over their distance ([`Frame::impulses`]); the mean over
+    /// the frames for a window of one frame.
+    fn means(&self) -> (f64, f64) {
+        match self.first {
+            Some((t0, i0)) if self.last.0 > t0 => {
+                let (t1, i1) = self.last;
+                let span = t1 - t0;
+                ((i1[0] - i0[0]) / span, (i1[1] - i0[1]) / span)
+            }
+            _ => {
+                let f = self.frames.max(1) as f64;
+                (self.normal_sum / f, self.tangential_sum / f)
+            }
+        }
+    }
+
+    /// Adds a frame at `at` [s] with the pair's totals (n, t) [N] and its
+    /// impulses (`None` when the simulation does not track them).
+    fn add(&mut self, (n, t): (f64, f64), at: f64, impulse: Option<PairTotals>) {
+        if let Some(impulse) = impulse {
+            self.first.get_or_insert((at, impulse));
+            self.last = (at, impulse);
+        }
         self.frames += 1;
         self.normal_peak = self.normal_peak.max(n);
         self.normal_sum += n;
@@ -137,6 +165,10 @@ pub struct Recorder {
     dissipated: Dissipated,
     /// Mechanical energy at the first frame [J].
     initial_total: Option<f64>,
+    /// Each pair's impulse at the frame being recorded, if the `summary`
+    /// table or an observer reads it ([`Frame::impulses`]).
+    needs_impulses: bool,
+    impulses: Vec<PairTotals>,
 }
 
 impl Recorder {
@@ -161,6 +193,8 @@ impl Recorder {
             .iter()
             .find_map(|o| o.body_parts())
             .unwrap_or_default();
+        let needs_impulses = model.record.tables.contains(&TableKind::Summary)
+            || observers.iter().any(|o| o.needs_impulses());
         let observers = observers
             .into_iter()
             .map(|observer| {
@@ -184,7 +218,15 @@ impl Recorder {
             needs_steps,
             dissipated: Dissipated::default(),
             initial_total: None,
+            needs_impulses,
+            impulses: Vec::new(),
         }
+    }
+
+    /// Whether the `summary` table or an observer reads the pairs'
+    /// impulses (the simulation then has its [`Dynamics`] track them).
+    pub fn needs_impulses(&self) -> bool {
+        self.needs_impulses
     }
 
     /// Every pair's contact points with their forces at `state`, into `evals`.
@@ -229,6 +271,9 @@ impl Recorder {
             self.evaluate(model, state, dynamics);
         }
         self.evals_current = false;
+        if self.needs_impulses {
+            dynamics.impulses_at(state.t, &mut self.impulses);
+        }
         let frame = (Cell::U64(step), Cell::F64(state.t));
         for (table, kind) in self.tables.iter_mut().zip(&self.engine) {
             match kind {
@@ -243,7 +288,8 @@ impl Recorder {
                     let (start, end) = model.record.summary_window;
                     if state.t >= start - 1e-12 && state.t <= end + 1e-12 {
                         for (k, s) in self.stats.iter_mut().enumerate() {
-                            s.add(contact_totals(&self.evals, &[k]));
+                            let impulse = self.impulses.get(k).copied();
+                            s.add(contact_totals(&self.evals, &[k]), state.t, impulse);
                         }
                     }
                 }
@@ -254,6 +300,7 @@ impl Recorder {
             state,
             step,
             contacts: &self.evals,
+            impulses: &self.impulses,
         };
         for r in &mut self.observers {
             r.observer.record(&view, &mut self.tables[r.tables.clone()]);
@@ -279,6 +326,7 @@ impl Recorder {
             }
             for (k, s) in self.stats.iter().enumerate() {
                 let f = s.frames.max(1) as f64;
+                let (normal_mean, tangential_mean) = s.means();
                 table.push(&[
                     Cell::U32(k as u32),
                     Cell::U32(k as u32),
@@ -286,10 +334,10 @@ impl Recorder {
                     Cell::F64(end.min(end_time)),
                     Cell::U64(s.frames),
                     Cell::F64(s.normal_peak),
-                    Cell::F64(s.normal_sum / f),
+                    Cell::F64(normal_mean),
                     Cell::F64(s.normal_squares.rms(f)),
                     Cell::F64(s.tangential_peak),
-                    Cell::F64(s.tangential_sum / f),
+                    Cell::F64(tangential_mean),
                     Cell::F64(s.tangential_squares.rms(f)),
                 ]);
             }

@@ -351,7 +351,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "normal_mean",
         F64,
         "N",
-        "mean per-frame total normal force (frames without contact count as 0)",
+        "time mean of the total normal force over the window's frames: its impulse, as the integrator applied it over its own steps, between the first and the last frame over their distance (the frame's value for a window of one frame)",
     ),
     col(
         "normal_rms",
@@ -369,7 +369,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "tangential_mean",
         F64,
         "N",
-        "mean per-frame magnitude of the summed friction force",
+        "time mean of the magnitude of the summed friction force, as normal_mean",
     ),
     col(
         "tangential_rms",

@@ -10,7 +10,7 @@
 use std::fmt::Debug;
 
 use super::{TableBuffer, TableDef};
-use crate::dynamics::ContactEval;
+use crate::dynamics::{ContactEval, PairTotals};
 use crate::math::Vec3;
 use crate::model::{Model, State};
 
@@ -27,6 +27,11 @@ pub struct Frame<'a> {
     /// Evaluated once per frame and shared by every table; empty lists when
     /// no table asked for contacts.
     pub contacts: &'a [Vec<ContactEval>],
+    /// Each pair's impulse since t = 0 as the integrator applied it, by
+    /// pair id: ∫ normal force dt and ∫ |summed friction force| dt [N·s]
+    /// ([`crate::dynamics::Impulses`]); empty unless an observer asked for
+    /// it ([`Observer::needs_impulses`]).
+    pub impulses: &'a [PairTotals],
 }
 
 /// What an observer sees after every integrator step, when it asks for it
@@ -100,6 +105,12 @@ pub trait Observer: Debug + Send + Sync {
 
     /// Sees the end of every integrator step (only if [`Self::needs_steps`]).
     fn step(&mut self, _step: &Step<'_>) {}
+
+    /// Whether it reads [`Frame::impulses`]; the integrators then keep
+    /// every pair's totals at every stage. Default: no.
+    fn needs_impulses(&self) -> bool {
+        false
+    }
 
     /// Appends the end-of-run rows at simulated time `end_time` [s]; `out`
     /// as in [`Self::record`]. Default: none.

@@ -118,7 +118,12 @@ pub fn oscillator(simulation: &str) -> Simulation {
 /// name (shape, mass, position, velocity), `contact` the floor–ball
 /// contact's keys besides its bodies (its laws).
 pub fn ball_on_floor(simulation: &str, g: f64, ball: &str, contact: &str) -> Simulation {
-    sim(&format!(
+    sim(&ball_on_floor_toml(simulation, g, ball, contact))
+}
+
+/// The scene document of [`ball_on_floor`].
+pub fn ball_on_floor_toml(simulation: &str, g: f64, ball: &str, contact: &str) -> String {
+    format!(
         r#"
         [simulation]
         {simulation}
@@ -138,7 +143,7 @@ pub fn ball_on_floor(simulation: &str, g: f64, ball: &str, contact: &str) -> Sim
         {contact}
         "#,
         neg_g = -g,
-    ))
+    )
 }
 
 /// The [`oscillator`]'s exact height [m] and vertical velocity [m/s] at `t`

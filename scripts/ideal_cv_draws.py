@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""The ideal-CV chain at a loose setting: error of its summed mean tube force and real-time factor, in draws.
+
+    python3 scripts/ideal_cv_draws.py [--duration S] [--window A B] [--rtol R] [--set KEY=VALUE ...]
+                                      [--out FILE.json] [--references EARLIER.json]
+
+Runs the embedded paper scene with ``pipe.hinge="ideal-cv"`` (docs/performance.md, "What limits the
+ideal-CV chain at loose tolerances"):
+
+- two references by different methods, SDIRK2 at 25 µs and ESDIRK3(2) at rtol 1e-6, 33 samples per link;
+  their difference is the reference's own error;
+- the setting given by ``--set`` (default: rtol 3e-2, steps up to 20 ms, Newton 3e-3, 3 samples per link,
+  frames every 10 ms) seven times, its rtol scaled by 0.9, 0.95, 0.97, 1, 1.03, 1.05 and 1.1: a change no
+  result should care about, so the spread of the seven is what one run of that setting is worth.
+
+Prints each run's summed mean tube force (``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s),
+its difference from the SDIRK2 reference, the real-time factor of the run's metadata and its force
+evaluations. Takes about 1.5 minutes on this project's machine (2026-11-27; the SDIRK2 reference is most
+of it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+from pathlib import Path
+
+import ballcage
+from ballcage.verify import headline
+
+QUANTITY = "tube_normal_mean_all_n"
+REFERENCES = {
+    "SDIRK2 25 µs": ['simulation.integrator="sdirk2"', "simulation.rtol=0", "simulation.dt=2.5e-5", "pipe.tube_contact_points=33"],
+    "ESDIRK3(2) rtol 1e-6": ["simulation.rtol=1e-6", "pipe.tube_contact_points=33"],
+}
+LOOSE = [
+    "simulation.max_step=2e-2",
+    "simulation.newton.tolerance=3e-3",
+    "pipe.tube_contact_points=3",
+    "simulation.output_interval=1e-2",
+]
+RTOL = 3e-2
+SCALES = (0.9, 0.95, 0.97, 1.0, 1.03, 1.05, 1.1)
+
+
+def measure(overrides: list[str], duration: float, window: tuple[float, float]) -> dict:
+    """One ideal-CV run: its summed mean tube force [N], real-time factor and force evaluations."""
+    common = ['pipe.hinge="ideal-cv"', f"simulation.duration={duration}", f"record.summary_window=[{window[0]}, {window[1]}]"]
+    run = ballcage.simulate({"kind": "drill-pipe"}, overrides=[*common, *overrides], progress=False)
+    meta = run.metadata
+    return {
+        "overrides": overrides,
+        "sum_n": headline(run)[QUANTITY][1],
+        "real_time_factor": float(meta["ballcage.real_time_factor"]),
+        "force_evaluations": int(meta["ballcage.force_evaluations"]),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--duration", type=float, default=1.8, help="simulated time [s] (default 1.8)")
+    parser.add_argument("--window", type=float, nargs=2, default=(0.4, 1.8), metavar=("A", "B"), help="the means' window [s]")
+    parser.add_argument("--out", default="out/ideal_cv_draws.json", help="where the raw results go (out/ is not tracked)")
+    parser.add_argument("--set", action="append", default=None, metavar="KEY=VALUE", help="the loose setting, besides rtol")
+    parser.add_argument("--rtol", type=float, default=RTOL, help=f"the loose setting's middle rtol (default {RTOL})")
+    parser.add_argument("--references", metavar="FILE.json", help="reuse the references of an earlier --out (same duration and window)")
+    args = parser.parse_args()
+    window = (args.window[0], args.window[1])
+    loose = LOOSE if args.set is None else args.set
+    if args.references:
+        earlier = json.loads(Path(args.references).read_text())
+        if tuple(earlier["window"]) != window or earlier.get("duration") != args.duration:
+            parser.error(f"--references {args.references}: its duration and window differ from this run's")
+        refs = earlier["references"]
+    else:
+        refs = {name: measure(o, args.duration, window) for name, o in REFERENCES.items()}
+    ref = refs["SDIRK2 25 µs"]["sum_n"]
+    other = refs["ESDIRK3(2) rtol 1e-6"]["sum_n"]
+    print(f"references: SDIRK2 25 µs {ref:.2f} N, ESDIRK3(2) rtol 1e-6 {other:.2f} N ({100 * abs(other - ref) / ref:.3f} % apart)")
+    print(f"setting: rtol {args.rtol:g} x scale, {' '.join(loose)}")
+    print("| rtol | sum [N] | error | real-time factor | force evaluations |")
+    print("|---:|---:|---:|---:|---:|")
+    draws = []
+    for scale in SCALES:
+        d = measure([f"simulation.rtol={args.rtol * scale:.6g}", *loose], args.duration, window)
+        d["error"] = abs(d["sum_n"] - ref) / ref
+        draws.append(d)
+        print(f"| {args.rtol * scale:.4g} | {d['sum_n']:.2f} | {100 * d['error']:.3f} % | {d['real_time_factor']:.1f} | {d['force_evaluations']} |")
+    errors = [d["error"] for d in draws]
+    factors = [d["real_time_factor"] for d in draws]
+    print(f"error {100 * min(errors):.3f}-{100 * max(errors):.3f} %, real-time factor {min(factors):.1f}-{max(factors):.1f} (median {statistics.median(factors):.1f})")
+    out = Path(args.out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps({"references": refs, "draws": draws, "window": window, "duration": args.duration}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
