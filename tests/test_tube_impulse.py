@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import ballcage
-from ballcage._links import link_tube_forces
+from ballcage._links import link_tube_forces, time_mean
 
 # Ideal-CV hinges over 0.4 s: the chain is pushed into the bend and rings on the tube wall.
 IDEAL_CV = ['pipe.hinge="ideal-cv"', "simulation.duration=0.4"]
@@ -83,3 +83,19 @@ def test_a_scene_of_prescribed_bodies_has_time_means_too(integrator):
     assert row["frames"] == 11
     assert row["normal_mean"] == pytest.approx(100.0, rel=1e-9)
     assert row["tangential_mean"] == 0.0
+
+
+def test_a_links_table_without_the_impulse_columns_gives_the_trapezoid_mean():
+    # An older file: the force sampled at frames 0.1 s apart. For f(t) = 100 t^2 N over [0.2, 0.8] the trapezoid
+    # rule gives 0.05 * (13 + 25 + 41 + 61 + 85 + 113) / 0.6 = 169/6 N; the exact mean, 100 (0.8^3 - 0.2^3) / 3 / 0.6,
+    # is 28 N. A window of one frame is that frame's value.
+    t = np.round(np.arange(0.0, 1.0001, 0.1), 12)
+    f = 100.0 * t**2
+    inside = (t >= 0.2 - 1e-12) & (t <= 0.8 + 1e-12)
+    trapezoid = float(np.sum(0.5 * (f[3:9] + f[2:8]) * 0.1)) / 0.6
+    assert time_mean(t, f, None, inside) == pytest.approx(trapezoid, rel=1e-12)
+    assert trapezoid == pytest.approx(169.0 / 6.0, rel=1e-12)
+    # With the engine's integral the mean is its growth, whatever the frames show.
+    assert time_mean(t, f, 100.0 * t**3 / 3.0, inside) == pytest.approx(28.0, rel=1e-12)
+    one = t == 0.5
+    assert time_mean(t, f, None, one) == pytest.approx(25.0)
