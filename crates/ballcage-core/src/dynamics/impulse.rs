@@ -80,13 +80,9 @@ impl Impulses {
     /// Stage `to` takes stage `from`'s totals (a first stage known from
     /// the step before).
     pub(super) fn copy_stage(&mut self, from: usize, to: usize) {
-        let (a, b) = (from.min(to), from.max(to));
-        let (lo, hi) = self.stage.split_at_mut(b);
-        if from < to {
-            hi[0].copy_from_slice(&lo[a]);
-        } else {
-            lo[a].copy_from_slice(&hi[0]);
-        }
+        let source = std::mem::take(&mut self.stage[from]);
+        self.stage[to].copy_from_slice(&source);
+        self.stage[from] = source;
     }
 
     /// Adds the step of `h` [s] from `t0` [s] just accepted: h·Σ w·F over
