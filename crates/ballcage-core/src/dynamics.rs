@@ -85,6 +85,19 @@ impl ContactEval {
     }
 }
 
+/// Whether the contact points at the end of a step the integrator kept
+/// are to be read from the last evaluation ([`Dynamics::last_contact_points`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Evaluated {
+    /// The last evaluation was Newton's last iterate of the step's last
+    /// stage: the step's end to Newton's tolerance (adaptive steps; no
+    /// further evaluation).
+    LastIterate,
+    /// Not known to be at the step's end: evaluate there (a fixed step, or
+    /// an adaptive step taken by the first-order fallback).
+    No,
+}
+
 /// What the laws of one contact point give: [`ContactEval`] without its
 /// point, so that an evaluation does not copy the points (the fields as
 /// there).
@@ -601,20 +614,28 @@ impl Dynamics {
         state: &State,
         out: &mut [Vec<ContactEval>],
     ) {
-        let kept = self.kept_at(state);
+        if self.kept_at(state) {
+            self.last_contact_points(out);
+            return;
+        }
         for (k, out) in out.iter_mut().enumerate() {
             out.clear();
-            if kept {
-                let (points, laws) = self.table.pair(k);
-                out.extend(
-                    points
-                        .iter()
-                        .zip(laws)
-                        .map(|(p, (law, _))| ContactEval::new(*p, law)),
-                );
-            } else {
-                self.contact_points(model, state, k, out);
-            }
+            self.contact_points(model, state, k, out);
+        }
+    }
+
+    /// Every pair's contact points as the last evaluation found them, at
+    /// whatever state that was (`out[k]` for pair k, each cleared first).
+    pub fn last_contact_points(&self, out: &mut [Vec<ContactEval>]) {
+        for (k, out) in out.iter_mut().enumerate() {
+            out.clear();
+            let (points, laws) = self.table.pair(k);
+            out.extend(
+                points
+                    .iter()
+                    .zip(laws)
+                    .map(|(p, (law, _))| ContactEval::new(*p, law)),
+            );
         }
     }
 

@@ -3,7 +3,7 @@
 use std::time::{Duration, Instant};
 
 use crate::assembly::assemble;
-use crate::dynamics::{ContactEval, ContactWatch, Dynamics, Energy};
+use crate::dynamics::{ContactEval, ContactWatch, Dynamics, Energy, Evaluated};
 use crate::error::{SceneError, SimulationError};
 use crate::integrate::{self, ErrorStats, Stats, Workspace};
 use crate::math::Vec3;
@@ -84,18 +84,31 @@ struct EnergyBalance {
     initial_gravity: f64,
     /// Kinetic and contact energy at t = 0 [J].
     initial_free: f64,
-    /// Net work of the drives and applied torques so far [J].
-    work_in: f64,
-    /// Of it, the drives' (prescribed motions') [J].
-    work_drive: f64,
-    /// Of it, the applied torques' [J].
-    work_load: f64,
-    /// ∫|P| of each input so far [J].
-    work_abs: f64,
+    /// The input work up to the end of the last step the integrator kept.
+    work: InputWork,
+    /// The same at that step's start, and the step's span [s]: a frame
+    /// within the step takes the work interpolated to its time.
+    before: InputWork,
+    span: (f64, f64),
+    /// The drives', the loads' and the summed absolute input power [W] at
+    /// the end of the last step (`None` before the first step).
+    power: Option<[f64; 3]>,
     /// Largest gravitational energy released or stored so far, |ΔPE_g| [J].
     gravity_swing: f64,
-    /// Net input power at the last frame [W].
-    power: f64,
+}
+
+/// Work of the drives and applied torques since t = 0 [J], summed over the
+/// integrator's steps.
+#[derive(Debug, Clone, Copy, Default)]
+struct InputWork {
+    /// Net work of the drives and applied torques [J].
+    net: f64,
+    /// Of it, the drives' (prescribed motions') [J].
+    drive: f64,
+    /// Of it, the applied torques' and forces' [J].
+    load: f64,
+    /// ∫|P| of each input [J].
+    abs: f64,
 }
 
 impl Simulation {
@@ -252,12 +265,18 @@ impl Simulation {
         let h = self.model.dt;
         self.dynamics.watch.reset();
         self.halvings_before_step = self.workspace.stats().halvings;
+        let (model, balance, recorder) = (&self.model, &mut self.balance, &mut self.recorder);
+        let mut accepted = |state: &State, h: f64, dynamics: &mut Dynamics, evaluated| {
+            balance.add_step(model, state, h, dynamics);
+            recorder.after_step(model, state, h, dynamics, evaluated);
+        };
         if let Err(reason) = integrate::step(
-            &self.model,
+            model,
             &mut self.dynamics,
             &mut self.workspace,
             &mut self.state,
             self.step,
+            &mut accepted,
         ) {
             return self.fail_with(reason, Failure::Integrator);
         }
@@ -270,20 +289,22 @@ impl Simulation {
         if let Some(reason) = self.too_deep() {
             return self.fail_with(reason, Failure::Penetration);
         }
-        self.add_input_work(h);
-        self.recorder
-            .after_step(&self.model, &self.state, h, &mut self.dynamics);
+        if self.model.tolerance.is_none() {
+            let (model, state) = (&self.model, &self.state);
+            self.balance.add_step(model, state, h, &self.dynamics);
+            (self.recorder).after_step(model, state, h, &mut self.dynamics, Evaluated::No);
+        }
         if self.step.is_multiple_of(self.model.steps_per_output) {
             if let Some(reason) = self.energy_created() {
                 return self.fail_with(reason, Failure::Energy);
             }
-            let b = &self.balance;
+            let work = self.balance.work_at(self.state.t);
             self.recorder.record(
                 &self.model,
                 &self.state,
                 self.step,
                 &mut self.dynamics,
-                (b.work_drive, b.work_load),
+                (work.drive, work.load),
             );
         }
         if self.dynamics.watch.saw_contact() {
@@ -673,36 +694,6 @@ impl Simulation {
         ))
     }
 
-    /// Adds the work of the applied torques and forces and of the prescribed bodies
-    /// (minus what the joints and contacts do on them) over the step, from
-    /// the last force evaluation and the new velocities.
-    fn add_input_work(&mut self, h: f64) {
-        let (model, state, b) = (&self.model, &self.state, &mut self.balance);
-        let work_before = b.work_in;
-        for l in &model.torques {
-            let p = l.torque(state.t).dot(&state.omega_world(l.body));
-            b.work_load += p * h;
-            b.work_in += p * h;
-            b.work_abs += p.abs() * h;
-        }
-        for l in &model.forces {
-            let p = l.force(state.t).dot(&state.vel[l.body]);
-            b.work_load += p * h;
-            b.work_in += p * h;
-            b.work_abs += p.abs() * h;
-        }
-        let (force, torque) = (self.dynamics.forces(), self.dynamics.torques());
-        for (i, body) in model.bodies.iter().enumerate() {
-            if matches!(body.motion, Motion::KinematicSpin(_)) {
-                let p = -(force[i].dot(&state.vel[i]) + torque[i].dot(&state.omega_world(i)));
-                b.work_drive += p * h;
-                b.work_in += p * h;
-                b.work_abs += p.abs() * h;
-            }
-        }
-        b.power = (b.work_in - work_before) / h;
-    }
-
     /// Checks that the mechanical energy has not grown beyond the input
     /// work by more than the divergence tolerance. Physically
     /// E(t) − E(0) − W_in(t) ≤ 0 (the contacts and joints only dissipate);
@@ -715,7 +706,8 @@ impl Simulation {
         b.gravity_swing = b
             .gravity_swing
             .max((e.potential_gravity - b.initial_gravity).abs());
-        let (created, scale) = self.balance.excess(&e, 0.0);
+        let work = self.balance.work_at(self.state.t);
+        let (created, scale) = self.balance.excess(&e, &work);
         let limit = self.model.energy_growth * scale;
         let share = if created <= 1e-12 {
             0.0
@@ -738,16 +730,15 @@ impl Simulation {
              simulation.divergence.energy_growth = {} of the energy scale {scale:.4e} J",
             e.total(),
             b.initial,
-            b.work_in,
+            b.work_at(self.state.t).net,
             self.model.energy_growth
         ))
     }
 
     /// For a frame interpolated within an adaptive step that failed the
     /// energy balance, the balance at the integrator's own state at the
-    /// step's end ([`Self::energy_created`], with the input work carried to
-    /// the step's end at the frame's input power): the run stops only if
-    /// that fails too. The
+    /// step's end ([`Self::energy_created`], with the input work summed to
+    /// that end): the run stops only if that fails too. The
     /// interpolant's error is not controlled: within a step over which a
     /// stiff transient settles, its velocities, cubic Hermite from the
     /// accelerations at the step's ends, overshoot (three ideal-CV links at
@@ -761,7 +752,7 @@ impl Simulation {
     fn own_state_share(&mut self) -> Option<f64> {
         let own = self.workspace.state_ahead_of_frame()?;
         let e = self.dynamics.energy(&self.model, own);
-        let (created, scale) = self.balance.excess(&e, own.t - self.state.t);
+        let (created, scale) = self.balance.excess(&e, &self.balance.work);
         let limit = self.model.energy_growth * scale;
         Some(if created <= 1e-12 {
             0.0
@@ -772,21 +763,73 @@ impl Simulation {
 }
 
 impl EnergyBalance {
-    /// The energy created at a state of energy `e` [J] `span` [s] past the
-    /// last frame (the input work carried there at the frame's power), and
-    /// the energy scale it is measured against: the most the system could
-    /// hold (initial kinetic and contact energy, gravitational energy
-    /// released, ∫|P_in| dt) [J].
-    fn excess(&self, e: &Energy, span: f64) -> (f64, f64) {
-        let carried = if span == 0.0 { 0.0 } else { self.power * span };
+    /// The energy created at a state of energy `e` [J], against the input
+    /// work `work`, and the energy scale it is measured against: the most
+    /// the system could hold (initial kinetic and contact energy,
+    /// gravitational energy released, ∫|P_in| dt) [J].
+    fn excess(&self, e: &Energy, work: &InputWork) -> (f64, f64) {
         let swing = self
             .gravity_swing
             .max((e.potential_gravity - self.initial_gravity).abs());
-        let created = e.total() - self.initial - (self.work_in + carried);
-        (
-            created,
-            self.initial_free + swing + self.work_abs + carried.abs(),
-        )
+        let created = e.total() - self.initial - work.net;
+        (created, self.initial_free + swing + work.abs)
+    }
+
+    /// Adds the work of the applied torques and forces and of the
+    /// prescribed bodies (minus what the joints and contacts do on them)
+    /// over a step of `h` [s] that ended at `state`, by the trapezoidal rule
+    /// as the dissipated energies (the powers at the step's end from the
+    /// last force evaluation and the end's velocities; the first step has
+    /// only its end).
+    fn add_step(&mut self, model: &Model, state: &State, h: f64, dynamics: &Dynamics) {
+        // [drive, load, Σ|P|] [W]
+        let mut p = [0.0; 3];
+        let mut add = |w: f64, k: usize| {
+            p[k] += w;
+            p[2] += w.abs();
+        };
+        for l in &model.torques {
+            add(l.torque(state.t).dot(&state.omega_world(l.body)), 1);
+        }
+        for l in &model.forces {
+            add(l.force(state.t).dot(&state.vel[l.body]), 1);
+        }
+        let (force, torque) = (dynamics.forces(), dynamics.torques());
+        for (i, body) in model.bodies.iter().enumerate() {
+            if matches!(body.motion, Motion::KinematicSpin(_)) {
+                add(
+                    -(force[i].dot(&state.vel[i]) + torque[i].dot(&state.omega_world(i))),
+                    0,
+                );
+            }
+        }
+        let before = self.power.replace(p).unwrap_or(p);
+        let work = |k: usize| 0.5 * (before[k] + p[k]) * h;
+        self.before = self.work;
+        self.span = (state.t - h, state.t);
+        let w = &mut self.work;
+        w.drive += work(0);
+        w.load += work(1);
+        w.net += work(0) + work(1);
+        w.abs += work(2);
+    }
+
+    /// The input work at time `t` [s]: the sum to the last step's end,
+    /// interpolated linearly within that step for a frame inside it.
+    fn work_at(&self, t: f64) -> InputWork {
+        let (t0, t1) = self.span;
+        if t >= t1 || t1 <= t0 {
+            return self.work;
+        }
+        let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        let (a, b) = (&self.before, &self.work);
+        let mix = |x: f64, y: f64| x + s * (y - x);
+        InputWork {
+            net: mix(a.net, b.net),
+            drive: mix(a.drive, b.drive),
+            load: mix(a.load, b.load),
+            abs: mix(a.abs, b.abs),
+        }
     }
 }
 

@@ -483,10 +483,19 @@ impl Observer for PipeTables {
     fn step(&mut self, step: &Step<'_>) {
         let t = step.state.t;
         let (start, end) = self.window;
-        // the step (t − h, t] counts toward the window when it ends inside it
-        let in_window = t > start + 1e-12 && t <= end + 1e-12;
+        // The part of the step (t − h, t] inside the window and the run
+        // (an adaptive step may end past a window's edge, or the run's).
+        let model = step.model;
+        let end = end.min(model.total_steps as f64 * model.dt);
+        let inside = (t.min(end) - (t - step.h).max(start)).max(0.0);
+        // Round-off of a step that ends on an edge counts as outside.
+        let inside = if inside <= 1e-12 * step.h {
+            0.0
+        } else {
+            inside
+        };
         for ((w, s), points) in self.wear.iter_mut().zip(&self.stress).zip(step.contacts) {
-            w.add(s, step.state, points, step.h, in_window);
+            w.add(s, step.state, points, inside);
         }
     }
 

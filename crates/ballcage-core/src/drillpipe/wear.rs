@@ -24,6 +24,9 @@ pub struct PairWear {
     pub pressure_sliding: f64,
     /// The largest peak pressure over the run.
     pub peak: Option<Peak>,
+    /// The four integrands above at the end of the last step (`None`
+    /// before the first), for the trapezoidal rule.
+    pub rates: Option<[f64; 4]>,
 }
 
 /// The largest Hertz peak pressure of a pair over a run.
@@ -40,16 +43,14 @@ pub struct Peak {
 }
 
 impl PairWear {
-    /// Adds one step of length `h` [s] at `state` (time `t`), points `points`;
-    /// `in_window` says whether the step counts toward the window's integrals.
-    pub fn add(
-        &mut self,
-        stress: &PairStress,
-        state: &State,
-        points: &[ContactEval],
-        h: f64,
-        in_window: bool,
-    ) {
+    /// Adds the step that ended at `state` (time `t`), points `points`: its
+    /// pressure to the peak, and its rates to the window's integrals over
+    /// `h` [s], the part of the step inside the window (0 for a step
+    /// outside it), by the trapezoidal rule (the rates at the step's two
+    /// ends; the first step has only its end), as the `energy` table's work.
+    pub fn add(&mut self, stress: &PairStress, state: &State, points: &[ContactEval], h: f64) {
+        // [friction power, slip speed, F_n·v, p_mean·v]
+        let mut rates = [0.0; 4];
         for e in points {
             let (c, mean) = stress.patch(state, e);
             if c.peak_pressure > self.peak.map_or(0.0, |p| p.pressure) {
@@ -60,17 +61,23 @@ impl PairWear {
                     semi_axes: (c.semi_major, c.semi_minor),
                 });
             }
-            if in_window {
-                let v = e.slip_speed;
-                // Signed by the point's weight: a level-set minimum (−1)
-                // takes back its share of its neighbours' friction work.
-                self.friction_work += e.point.weight * e.tangential_force.norm() * v * h;
-                if e.point.weight > 0.0 {
-                    self.sliding += v * h;
-                }
-                self.normal_sliding += e.normal_force * v * h;
-                self.pressure_sliding += mean * v * h;
+            let v = e.slip_speed;
+            // Signed by the point's weight: a level-set minimum (−1)
+            // takes back its share of its neighbours' friction work.
+            rates[0] += e.point.weight * e.tangential_force.norm() * v;
+            if e.point.weight > 0.0 {
+                rates[1] += v;
             }
+            rates[2] += e.normal_force * v;
+            rates[3] += mean * v;
+        }
+        let before = self.rates.replace(rates).unwrap_or(rates);
+        if h > 0.0 {
+            let integral = |k: usize| 0.5 * (before[k] + rates[k]) * h;
+            self.friction_work += integral(0);
+            self.sliding += integral(1);
+            self.normal_sliding += integral(2);
+            self.pressure_sliding += integral(3);
         }
     }
 }

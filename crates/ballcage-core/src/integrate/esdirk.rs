@@ -34,7 +34,8 @@
 //! from A_i extrapolated from the stages before ([`Implicit::predict`]).
 
 use super::{Basis, Implicit, Scheme, StageFailure};
-use crate::dynamics::{Dynamics, Mode};
+use crate::dynamics::{Dynamics, Evaluated, Mode};
+use crate::integrate::Accepted;
 use crate::math::{Vec3, dexp_inv};
 use crate::model::{Model, Motion, State};
 use crate::scene::Tolerance;
@@ -254,26 +255,28 @@ impl Implicit {
         dynamics: &mut Dynamics,
         state: &mut State,
         h: f64,
+        accepted: &mut Accepted<'_>,
     ) -> Result<(), String> {
         self.scheme = Scheme::Esdirk32;
         let n = self.n;
         self.esdirk.get_or_insert_with(|| Box::new(Stages::new(n)));
         match model.tolerance {
             None => self.sdirk2_split(model, dynamics, state, h, 0),
-            Some(tol) => self.esdirk_adaptive(model, dynamics, state, h, &tol),
+            Some(tol) => self.esdirk_adaptive(model, dynamics, state, (h, &tol), accepted),
         }
     }
 
     /// Adaptive steps, none longer than `simulation.max_step`, until the
     /// frame `big` [s] after `state.t` is reached or passed; `state` is then
-    /// that frame (interpolated when a step passed it).
+    /// that frame (interpolated when a step passed it). `accepted` sees the
+    /// end of each step kept, before the frame is handed out.
     fn esdirk_adaptive(
         &mut self,
         model: &Model,
         dynamics: &mut Dynamics,
         state: &mut State,
-        big: f64,
-        tol: &Tolerance,
+        (big, tol): (f64, &Tolerance),
+        accepted: &mut Accepted<'_>,
     ) -> Result<(), String> {
         let t_end = state.t + big;
         let mut cur = self.own_state(state, big);
@@ -301,6 +304,7 @@ impl Implicit {
                     if self.control(h, proposed, err) {
                         self.keep_dense(&saved, h, false);
                         dynamics.note_accepted(saved.t, h, &STAGE_WEIGHTS, 3);
+                        accepted(&cur, h, dynamics, Evaluated::LastIterate);
                         Ok(())
                     } else {
                         cur.clone_from(&saved);
@@ -328,6 +332,7 @@ impl Implicit {
                     self.keep_dense(&saved, h, true);
                     let es = self.esdirk.as_mut().expect("made by esdirk_step");
                     es.stats.smallest_step = es.stats.smallest_step.min(h);
+                    accepted(&cur, h, dynamics, Evaluated::No);
                     Ok(())
                 }
                 Err(e) => Err(format!("{e} {}", too_small(h, largest).unwrap_or_default())),

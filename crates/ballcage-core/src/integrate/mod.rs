@@ -16,7 +16,7 @@ mod sparselu;
 pub(crate) use implicit::MIN_STEP_FRACTION;
 pub use implicit::{ErrorStats, Stats};
 
-use crate::dynamics::{Accel, Dynamics, Mode};
+use crate::dynamics::{Accel, Dynamics, Evaluated, Mode};
 use crate::math::{Vec3, dexp_inv, exp_map};
 use crate::model::{Model, State};
 use crate::scene::IntegratorKind;
@@ -83,6 +83,13 @@ impl Workspace {
 /// (n + 1)·dt exactly, so that time does not drift by round-off over a run
 /// (the prescribed motions inside the step are evaluated at t_n + dt).
 ///
+/// With adaptive steps, `accepted` sees each step the controller keeps on
+/// the way to the frame, at its end: the state there, the step's length
+/// [s] and the dynamics ([`Accepted`]). Those steps do not end on the
+/// frames, so integrals over the run (work, wear) are summed there, over
+/// the integrator's steps, and not over the frames a user chose. A fixed
+/// step is itself the one step kept: the caller integrates over it.
+///
 /// An error says why an implicit step could not be solved (the state is then
 /// left at the start of the step, or for SDIRK2 at the end of the last part
 /// step that converged). A state that became non-finite is for the caller to
@@ -93,6 +100,7 @@ pub fn step(
     ws: &mut Workspace,
     state: &mut State,
     n: u64,
+    accepted: &mut Accepted<'_>,
 ) -> Result<(), String> {
     fn implicit<'a>(ws: &'a mut Workspace, model: &Model) -> &'a mut implicit::Implicit {
         ws.implicit
@@ -106,11 +114,18 @@ pub fn step(
             implicit(ws, model).step(model, dynamics, state, h)
         }
         IntegratorKind::Sdirk2 => implicit(ws, model).sdirk2_step(model, dynamics, state, h)?,
-        IntegratorKind::Esdirk32 => implicit(ws, model).esdirk_step(model, dynamics, state, h)?,
+        IntegratorKind::Esdirk32 => {
+            implicit(ws, model).esdirk_step(model, dynamics, state, h, accepted)?
+        }
     }
     state.t = (n + 1) as f64 * h;
     Ok(())
 }
+
+/// What sees each step the integrator keeps ([`step`]): its end state, its
+/// length h [s], the dynamics, and whether the dynamics' last evaluation
+/// is the one to read for the step's end.
+pub type Accepted<'a> = dyn FnMut(&State, f64, &mut Dynamics, Evaluated) + 'a;
 
 /// v ← v + h·a(x, v); x ← x + h·v; R ← R·Exp(h·ω).
 fn symplectic_euler(
