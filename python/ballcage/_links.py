@@ -11,8 +11,14 @@ cumulative impulse (``links.tube_normal_impulse``, ``tube_tangential_impulse``
 window's ends, over the window's length. It therefore does not depend on
 ``simulation.output_interval`` (docs/accuracy.md, "A mean force is a mean over
 time"). A ``links`` table without those columns (written before they existed)
-gives the impulse by the trapezoid rule over its frames. Peaks are the largest
-value at a frame.
+gives the impulse by the trapezoid rule over its frames.
+
+A peak is the largest force the integrator saw: ``links.tube_normal_max`` holds,
+at each frame, the largest ``tube_normal`` at any stage of the steps accepted
+since the frame before, so the peak over a window is the window's first frame's
+``tube_normal`` and the largest ``tube_normal_max`` after it. That too does not
+depend on the output interval; an impact between two frames counts. A ``links``
+table without the column gives the largest value at a frame.
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ import numpy as np
 from ballcage import _native
 from ballcage.run import Run
 
-__all__ = ["LinkTubeForces", "in_summary_window", "link_tube_forces", "summary_window", "time_mean"]
+__all__ = ["LinkTubeForces", "in_summary_window", "link_tube_forces", "summary_window", "time_mean", "window_peak"]
 
 #: Slack [s] on the window's ends, as the engine's summary table applies it.
 WINDOW_SLACK = 1e-12
@@ -39,7 +45,7 @@ class LinkTubeForces:
     end: float  # last time of the window, at most the last frame [s]
     frames: int  # frames in the window
     normal_mean: dict[int, float]  # time mean of links.tube_normal [N]
-    normal_peak: dict[int, float]  # largest links.tube_normal at a frame [N]
+    normal_peak: dict[int, float]  # largest links.tube_normal the integrator saw (links.tube_normal_max) [N]
     tangential_mean: dict[int, float]  # time mean of links.tube_tangential [N]
 
 
@@ -68,6 +74,7 @@ def link_tube_forces(run: Run) -> LinkTubeForces | None:
     link = links.column("link").to_numpy()
     normal = links.column("tube_normal").to_numpy()
     tangential = links.column("tube_tangential").to_numpy()
+    since = links.column("tube_normal_max").to_numpy() if "tube_normal_max" in links.column_names else None
     integrals = {
         name: links.column(name).to_numpy() if name in links.column_names else None
         for name in ("tube_normal_impulse", "tube_tangential_impulse")
@@ -82,7 +89,7 @@ def link_tube_forces(run: Run) -> LinkTubeForces | None:
         if not mask.any():
             normal_mean[k] = normal_peak[k] = tangential_mean[k] = 0.0
             continue
-        normal_peak[k] = float(normal[rows][mask].max())
+        normal_peak[k] = window_peak(normal[rows], None if since is None else since[rows], mask)
         for out, value, integral in (
             (normal_mean, normal, integrals["tube_normal_impulse"]),
             (tangential_mean, tangential, integrals["tube_tangential_impulse"]),
@@ -90,6 +97,19 @@ def link_tube_forces(run: Run) -> LinkTubeForces | None:
             out[k] = time_mean(t[rows], value[rows], None if integral is None else integral[rows], mask)
     frames = int(np.unique(t[inside]).size)
     return LinkTubeForces(start, min(end, float(t.max())), frames, normal_mean, normal_peak, tangential_mean)
+
+
+def window_peak(value: np.ndarray, since: np.ndarray | None, inside: np.ndarray) -> float:
+    """The largest `value` over the frames `inside` (a window of frames at ascending times).
+
+    With `since` (each frame's largest value since the frame before, at the integrator's stages): the first
+    frame's `value` and the largest `since` of the frames after it, which covers every step that starts
+    within the window; without it, the largest `value` at a frame.
+    """
+    if since is None:
+        return float(value[inside].max())
+    rows = np.flatnonzero(inside)
+    return float(max(value[rows[0]], since[rows[1:]].max(initial=-np.inf)))
 
 
 def time_mean(t: np.ndarray, value: np.ndarray, impulse: np.ndarray | None, inside: np.ndarray) -> float:

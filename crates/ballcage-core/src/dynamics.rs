@@ -490,6 +490,16 @@ impl Dynamics {
         }
     }
 
+    /// Each pair's largest totals [N] at any stage of the steps accepted
+    /// since the last call ([`Impulses::take_peaks`]; −∞ where none, empty
+    /// when impulses are not tracked).
+    pub fn take_peaks(&mut self, out: &mut Vec<PairTotals>) {
+        match &mut self.impulses {
+            Some(i) => i.take_peaks(out),
+            None => out.clear(),
+        }
+    }
+
     /// The last evaluation was stage `s`'s last ([`Impulses::take_stage`]).
     pub(crate) fn note_stage(&mut self, s: usize) {
         if let Some(i) = &mut self.impulses {

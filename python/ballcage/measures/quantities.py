@@ -149,7 +149,7 @@ _EXTRA: dict[str, tuple[str, str]] = {
         "N",
         "largest per-link time mean of links.tube_normal over the summary window (the paper's sweep quantity tube_mean_max)",
     ),
-    "tube_normal_peak_max_n": ("N", "largest links.tube_normal of any link and frame of the summary window"),
+    "tube_normal_peak_max_n": ("N", "largest links.tube_normal of any link over the summary window, at the integrator's stages (links.tube_normal_max)"),
     "key_peak_n": (
         "N",
         "largest race normal force on one key, max of keys.inner_normal and keys.outer_normal over all keys and "
@@ -183,7 +183,7 @@ def link_columns(link: int) -> dict[str, tuple[str, str]]:
     """The two per-link columns of link `link` (1 at the top): mean and peak tube normal force [N]."""
     return {
         f"tube_normal_mean_link_{link:02d}_n": ("N", f"time mean of links.tube_normal of link {link} over the summary window"),
-        f"tube_normal_peak_link_{link:02d}_n": ("N", f"largest links.tube_normal of link {link} over the summary window"),
+        f"tube_normal_peak_link_{link:02d}_n": ("N", f"largest links.tube_normal of link {link} over the summary window, at the integrator's stages"),
     }
 
 

@@ -133,8 +133,8 @@ _SUMS_AND_PEAKS = (
 DEFINITIONS: dict[str, str] = {
     **{key: _ours(key) for key in _TABLE3},
     "tube_normal_peak_joint10_n": (
-        "ours: largest links.tube_normal of link 10 (per-frame total normal force of its contact with the tube) "
-        "over the frames of the summary window"
+        "ours: largest links.tube_normal of link 10 (total normal force of its contact with the tube) over the "
+        "summary window, at every stage of the integrator's steps (links.tube_normal_max), not only at the frames"
     ),
     "tube_normal_mean_joint10_n": (
         "ours: time mean of links.tube_normal of link 10 over the summary window (its impulse "

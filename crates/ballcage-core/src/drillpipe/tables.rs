@@ -87,6 +87,18 @@ const LINKS_COLUMNS: &[ColumnDef] = &[
         "Hertz peak pressure p₀ of the link's most loaded tube contact: a line along the wall, an elliptical patch at a rim rounded to pipe.link_edge_radius; 0 without contact",
     ),
     col(
+        "tube_normal_max",
+        F64,
+        "N",
+        "largest tube_normal since the previous frame, at every stage of the integrator's steps accepted since then (this frame's own value at the first frame, or where a step spans several frames): the largest over a window of frames, whatever the output interval, is the largest of this column after the window's first frame and that frame's tube_normal",
+    ),
+    col(
+        "tube_tangential_max",
+        F64,
+        "N",
+        "largest tube_tangential since the previous frame, as tube_normal_max",
+    ),
+    col(
         "tube_normal_impulse",
         F64,
         "N*s",
@@ -569,6 +581,7 @@ fn links(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Fr
         let included = 180.0 - angle_between(&d, &axis(f, chain[k + 1])).to_degrees();
         let tube = &layout.tube_pairs[k - 1..k];
         let (tube_n, tube_t) = contact_totals(f.contacts, tube);
+        let since = f.peak(layout.tube_pairs[k - 1]);
         table.push(&[
             step,
             t,
@@ -586,6 +599,8 @@ fn links(table: &mut TableBuffer, layout: &Layout, stress: &[PairStress], f: &Fr
             Cell::F64(tube_n),
             Cell::F64(tube_t),
             Cell::F64(peak_pressure(stress, f, tube)),
+            Cell::F64(since[0]),
+            Cell::F64(since[1]),
             Cell::F64(impulse(f, tube, 0)),
             Cell::F64(impulse(f, tube, 1)),
         ]);

@@ -45,6 +45,9 @@ pub struct Impulses {
     /// Whether a step was accepted yet (`rate_end` is then the force at
     /// the next step's start).
     any: bool,
+    /// The largest totals at any stage of the steps accepted since the
+    /// last [`Self::take_peaks`] [N] (−∞ before any).
+    peak: Vec<PairTotals>,
 }
 
 impl Impulses {
@@ -60,6 +63,7 @@ impl Impulses {
             t_start: 0.0,
             t_end: 0.0,
             any: false,
+            peak: vec![[f64::NEG_INFINITY; 2]; pairs],
         }
     }
 
@@ -90,10 +94,15 @@ impl Impulses {
     pub(super) fn accept(&mut self, t0: f64, h: f64, weights: &[(usize, f64)], last: usize) {
         for k in 0..self.end.len() {
             let mut step = [0.0; 2];
+            let peak = &mut self.peak[k];
             for &(s, w) in weights {
-                step[0] += w * self.stage[s][k][0];
-                step[1] += w * self.stage[s][k][1];
+                let f = self.stage[s][k];
+                step[0] += w * f[0];
+                step[1] += w * f[1];
+                *peak = [peak[0].max(f[0]), peak[1].max(f[1])];
             }
+            let f = self.stage[last][k];
+            *peak = [peak[0].max(f[0]), peak[1].max(f[1])];
             self.start[k] = self.end[k];
             self.end[k] = [self.end[k][0] + h * step[0], self.end[k][1] + h * step[1]];
         }
@@ -105,6 +114,18 @@ impl Impulses {
         }
         self.rate_end.copy_from_slice(&self.stage[last]);
         (self.t_start, self.t_end, self.any) = (t0, t0 + h, true);
+    }
+
+    /// Each pair's largest totals [N] at any stage of the steps accepted
+    /// since the last call, into `out` (−∞ where no step was accepted);
+    /// starts the next interval. The stages are the integrator's own
+    /// samples of the force, so a peak between two frames is seen, and
+    /// the largest over a window of frames is the same for any output
+    /// interval: it covers the steps that start within the window.
+    pub fn take_peaks(&mut self, out: &mut Vec<PairTotals>) {
+        out.clear();
+        out.extend_from_slice(&self.peak);
+        self.peak.fill([f64::NEG_INFINITY; 2]);
     }
 
     /// The cumulative impulses [N·s] at `t` [s], into `out`: at the last

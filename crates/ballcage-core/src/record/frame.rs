@@ -46,18 +46,29 @@ impl PairStats {
         }
     }
 
-    /// Adds a frame at `at` [s] with the pair's totals (n, t) [N] and its
-    /// impulses (`None` when the simulation does not track them).
-    fn add(&mut self, (n, t): (f64, f64), at: f64, impulse: Option<PairTotals>) {
+    /// Adds a frame at `at` [s] with the pair's totals (n, t) [N], its
+    /// impulses and its largest totals since the previous frame
+    /// ([`Frame::peaks`]; both `None` when the simulation does not track
+    /// them). The peaks are those of the integrator's stages, the window's
+    /// first frame counting with its own totals: the largest over the
+    /// steps that start within the window, whatever the output interval.
+    fn add(
+        &mut self,
+        (n, t): (f64, f64),
+        at: f64,
+        impulse: Option<PairTotals>,
+        peak: Option<PairTotals>,
+    ) {
         if let Some(impulse) = impulse {
             self.first.get_or_insert((at, impulse));
             self.last = (at, impulse);
         }
+        let [peak_n, peak_t] = peak.filter(|_| self.frames > 0).unwrap_or([n, t]);
         self.frames += 1;
-        self.normal_peak = self.normal_peak.max(n);
+        self.normal_peak = self.normal_peak.max(peak_n);
         self.normal_sum += n;
         self.normal_squares.add(n);
-        self.tangential_peak = self.tangential_peak.max(t);
+        self.tangential_peak = self.tangential_peak.max(peak_t);
         self.tangential_sum += t;
         self.tangential_squares.add(t);
     }
@@ -190,6 +201,8 @@ pub struct Recorder {
     /// table or an observer reads it ([`Frame::impulses`]).
     needs_impulses: bool,
     impulses: Vec<PairTotals>,
+    /// Each pair's largest totals since the previous frame ([`Frame::peaks`]).
+    peaks: Vec<PairTotals>,
 }
 
 impl Recorder {
@@ -243,6 +256,7 @@ impl Recorder {
             initial_total: None,
             needs_impulses,
             impulses: Vec::new(),
+            peaks: Vec::new(),
         }
     }
 
@@ -322,6 +336,13 @@ impl Recorder {
         self.evals_current = false;
         if self.needs_impulses {
             dynamics.impulses_at(state.t, &mut self.impulses);
+            dynamics.take_peaks(&mut self.peaks);
+            for (k, p) in self.peaks.iter_mut().enumerate() {
+                if p[0] == f64::NEG_INFINITY {
+                    let (n, t) = contact_totals(&self.evals, &[k]);
+                    *p = [n, t];
+                }
+            }
         }
         let frame = (Cell::U64(step), Cell::F64(state.t));
         let dissipated = self.dissipated_at(state.t);
@@ -339,7 +360,8 @@ impl Recorder {
                     if state.t >= start - 1e-12 && state.t <= end + 1e-12 {
                         for (k, s) in self.stats.iter_mut().enumerate() {
                             let impulse = self.impulses.get(k).copied();
-                            s.add(contact_totals(&self.evals, &[k]), state.t, impulse);
+                            let peak = self.peaks.get(k).copied();
+                            s.add(contact_totals(&self.evals, &[k]), state.t, impulse, peak);
                         }
                     }
                 }
@@ -351,6 +373,7 @@ impl Recorder {
             step,
             contacts: &self.evals,
             impulses: &self.impulses,
+            peaks: &self.peaks,
         };
         for r in &mut self.observers {
             r.observer.record(&view, &mut self.tables[r.tables.clone()]);

@@ -345,7 +345,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "normal_peak",
         F64,
         "N",
-        "largest per-frame total normal force of the pair",
+        "largest total normal force of the pair in the window: at the window's first frame and at every stage of the integrator's steps accepted after it (the frame's own value where a step spans several frames), so a peak between frames counts and the output interval does not move it",
     ),
     col(
         "normal_mean",
@@ -363,7 +363,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "tangential_peak",
         F64,
         "N",
-        "largest per-frame magnitude of the summed friction force",
+        "largest magnitude of the summed friction force in the window, as normal_peak",
     ),
     col(
         "tangential_mean",

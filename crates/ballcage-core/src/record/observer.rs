@@ -32,6 +32,23 @@ pub struct Frame<'a> {
     /// ([`crate::dynamics::Impulses`]); empty unless an observer asked for
     /// it ([`Observer::needs_impulses`]).
     pub impulses: &'a [PairTotals],
+    /// Each pair's largest totals [N] (normal, friction magnitude) since the
+    /// previous frame, by pair id: at every stage of the integrator's steps
+    /// accepted since then, or the frame's own totals where none was (the
+    /// first frame; a frame inside a step longer than the output interval).
+    /// Empty unless [`Self::impulses`] is kept.
+    pub peaks: &'a [PairTotals],
+}
+
+impl Frame<'_> {
+    /// Pair `k`'s largest totals since the previous frame ([`Self::peaks`]),
+    /// or at this frame when they are not kept.
+    pub fn peak(&self, k: usize) -> PairTotals {
+        self.peaks.get(k).copied().unwrap_or_else(|| {
+            let (n, t) = contact_totals(self.contacts, &[k]);
+            [n, t]
+        })
+    }
 }
 
 /// What an observer sees after every integrator step, when it asks for it
