@@ -44,8 +44,15 @@ def write_all_atomically(files: Mapping[Path, Callable[[Path], object]]) -> None
     temporaries: list[tuple[Path, Path]] = []
     try:
         for final, write in files.items():
-            tmp = _create_temporary(final)
+            # Listed before it exists, so that a Ctrl-C landing between its creation and the listing cannot leave
+            # it behind (the clean-up tolerates a name never created); unlisted again if the name was taken.
+            tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
             temporaries.append((tmp, final))
+            try:
+                _create_temporary(tmp, final)
+            except OSError:
+                temporaries.pop()  # another writer's file, or none: not ours to remove
+                raise
             _fill(tmp, final, write)
         for tmp, final in temporaries:
             os.replace(tmp, final)
@@ -57,16 +64,14 @@ def write_all_atomically(files: Mapping[Path, Callable[[Path], object]]) -> None
         _fsync_directory(directory)
 
 
-def _create_temporary(final: Path) -> Path:
-    """Creates the empty hidden temporary ``.<name>.<8 hex digits>.tmp`` beside `final`; returns its path."""
-    tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
+def _create_temporary(tmp: Path, final: Path) -> None:
+    """Creates the empty hidden temporary `tmp` (``.<name>.<8 hex digits>.tmp`` beside `final`)."""
     try:
         # O_EXCL: never clobber another writer's temporary; mode 0o666 minus umask,
         # the permissions a plain open() would give the final file.
         os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
     except OSError as e:
         raise _naming(e, tmp, final) or e
-    return tmp
 
 
 def _fill(tmp: Path, final: Path, write: Callable[[Path], object]) -> None:
