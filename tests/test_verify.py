@@ -26,6 +26,11 @@ from ballcage.verify import VerificationError, compare, disagreements, tighter, 
 TWO_BALLS = Path(__file__).resolve().parent.parent / "examples" / "scenes" / "two_balls.toml"
 SDIRK2 = 'simulation.integrator="sdirk2"'
 COARSE, FINER = 1e-4, 5e-5  # s: the run's step; the contact lasts about 0.3 ms
+#: The quantities whose error already falls between those two steps. The RMS over time (∫F² dt, summed with the
+#: integrator's weights) does so only from 25 µs on, once the impact spans a dozen steps: 294.971, 294.941,
+#: 295.516, 295.652, 295.687, 295.695 N at 100, 50, 25, 12.5, 6.25, 3.125 µs (2026-11-27); its closed form is
+#: checked in crates/ballcage-core/tests/impulses.rs.
+ONCE_RESOLVED = ("normal_peak[impact]", "normal_mean[impact]")
 VERDICT = re.compile(r"^error ≤ ([0-9.e+-]+) % on (\S+) \(verified at (\S+): ([0-9.]+)× the run's time\)$")
 COLUMNS = {
     "quantity": pa.string(),
@@ -121,14 +126,14 @@ def test_the_measured_error_is_nonzero_and_falls_with_the_runs_step(runs):
     assert coarse.largest is not None and finer.largest is not None
     assert 1e-4 < coarse.largest < 0.2
     assert finer.largest < coarse.largest / 2  # second order: about 4x less at half the step
-    for name in ("normal_peak[impact]", "normal_mean[impact]", "normal_rms[impact]"):
+    for name in ONCE_RESOLVED:
         assert _rows(runs[FINER])[name]["abs_difference"] < _rows(runs[COARSE])[name]["abs_difference"]
 
 
 def test_the_tighter_run_is_closer_to_the_truth_than_the_run_it_checks(runs):
     # the two verification runs (25 and 12.5 us) agree better than the two runs (100 and 50 us)
     coarse, finer = _rows(runs[COARSE]), _rows(runs[FINER])
-    for name in ("normal_peak[impact]", "normal_mean[impact]", "normal_rms[impact]"):
+    for name in ONCE_RESOLVED:
         runs_apart = abs(coarse[name]["run_value"] - finer[name]["run_value"])
         checks_apart = abs(coarse[name]["verify_value"] - finer[name]["verify_value"])
         assert checks_apart < runs_apart / 4

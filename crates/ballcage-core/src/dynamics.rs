@@ -490,6 +490,15 @@ impl Dynamics {
         }
     }
 
+    /// Each pair's ∫F² dt of both totals since t = 0 [N²·s] at `t`
+    /// ([`Impulses::squares_at`]; empty when impulses are not tracked).
+    pub fn squares_at(&self, t: f64, out: &mut Vec<PairTotals>) {
+        match &self.impulses {
+            Some(i) => i.squares_at(t, out),
+            None => out.clear(),
+        }
+    }
+
     /// Each pair's largest totals [N] at any stage of the steps accepted
     /// since the last call ([`Impulses::take_peaks`]; −∞ where none, empty
     /// when impulses are not tracked).

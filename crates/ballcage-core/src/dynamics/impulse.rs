@@ -48,6 +48,11 @@ pub struct Impulses {
     /// The largest totals at any stage of the steps accepted since the
     /// last [`Self::take_peaks`] [N] (−∞ before any).
     peak: Vec<PairTotals>,
+    /// ∫F² dt of both totals since t = 0 at the last accepted step's start
+    /// and end [N²·s], by the same weights: a root mean square over a
+    /// window is √(growth / length).
+    squares_start: Vec<PairTotals>,
+    squares_end: Vec<PairTotals>,
 }
 
 impl Impulses {
@@ -59,11 +64,13 @@ impl Impulses {
             start: z.clone(),
             end: z.clone(),
             rate_start: z.clone(),
-            rate_end: z,
+            rate_end: z.clone(),
             t_start: 0.0,
             t_end: 0.0,
             any: false,
             peak: vec![[f64::NEG_INFINITY; 2]; pairs],
+            squares_start: z.clone(),
+            squares_end: z,
         }
     }
 
@@ -93,18 +100,23 @@ impl Impulses {
     /// its stages `weights` (stage, b), `last` the stage at its end.
     pub(super) fn accept(&mut self, t0: f64, h: f64, weights: &[(usize, f64)], last: usize) {
         for k in 0..self.end.len() {
-            let mut step = [0.0; 2];
+            let (mut step, mut squares) = ([0.0; 2], [0.0; 2]);
             let peak = &mut self.peak[k];
             for &(s, w) in weights {
                 let f = self.stage[s][k];
-                step[0] += w * f[0];
-                step[1] += w * f[1];
+                for i in 0..2 {
+                    step[i] += w * f[i];
+                    squares[i] += w * f[i] * f[i];
+                }
                 *peak = [peak[0].max(f[0]), peak[1].max(f[1])];
             }
             let f = self.stage[last][k];
             *peak = [peak[0].max(f[0]), peak[1].max(f[1])];
             self.start[k] = self.end[k];
             self.end[k] = [self.end[k][0] + h * step[0], self.end[k][1] + h * step[1]];
+            let q = self.squares_end[k];
+            self.squares_start[k] = q;
+            self.squares_end[k] = [q[0] + h * squares[0], q[1] + h * squares[1]];
         }
         let first = weights.first().map_or(last, |&(s, _)| s);
         if self.any {
@@ -131,23 +143,37 @@ impl Impulses {
     /// The cumulative impulses [N·s] at `t` [s], into `out`: at the last
     /// accepted step's end, or interpolated within that step.
     pub fn at(&self, t: f64, out: &mut Vec<PairTotals>) {
+        self.interpolate(t, (&self.start[..], &self.end[..]), |f| f, out);
+    }
+
+    /// The cumulative ∫F² dt of both totals [N²·s] at `t` [s], into `out`,
+    /// as [`Self::at`] (the slopes the squared totals at the step's ends).
+    pub fn squares_at(&self, t: f64, out: &mut Vec<PairTotals>) {
+        let ends = (&self.squares_start[..], &self.squares_end[..]);
+        self.interpolate(t, ends, |f| f * f, out);
+    }
+
+    /// The integral `ends` (at the last accepted step's start and end) at
+    /// `t` [s], into `out`; `rate` maps a total at a step's end to the
+    /// integrand there.
+    fn interpolate(
+        &self,
+        t: f64,
+        (start, end): (&[PairTotals], &[PairTotals]),
+        rate: impl Fn(f64) -> f64,
+        out: &mut Vec<PairTotals>,
+    ) {
         out.clear();
         let h = self.t_end - self.t_start;
         if !self.any || h <= 0.0 || t >= self.t_end - 1e-12 * h {
-            out.extend_from_slice(&self.end);
+            out.extend_from_slice(end);
             return;
         }
         let th = ((t - self.t_start) / h).clamp(0.0, 1.0);
-        out.extend((0..self.end.len()).map(|k| {
+        out.extend((0..end.len()).map(|k| {
             let f = |i: usize| {
-                let (i0, i1) = (self.start[k][i], self.end[k][i]);
-                monotone_hermite(
-                    i0,
-                    i1,
-                    h * self.rate_start[k][i],
-                    h * self.rate_end[k][i],
-                    th,
-                )
+                let (m0, m1) = (rate(self.rate_start[k][i]), rate(self.rate_end[k][i]));
+                monotone_hermite(start[k][i], end[k][i], h * m0, h * m1, th)
             };
             [f(0), f(1)]
         }));

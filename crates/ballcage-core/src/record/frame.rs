@@ -21,10 +21,10 @@ struct PairStats {
     tangential_peak: f64,
     tangential_sum: f64,
     tangential_squares: SumOfSquares,
-    /// The pair's impulses at the first and the last frame of the window:
-    /// (t [s], [normal, friction] [N·s]).
-    first: Option<(f64, PairTotals)>,
-    last: (f64, PairTotals),
+    /// The pair's integrals at the first and the last frame of the window:
+    /// (t [s], impulses [normal, friction] [N·s], ∫F² dt of both [N²·s]).
+    first: Option<(f64, PairTotals, PairTotals)>,
+    last: (f64, PairTotals, PairTotals),
 }
 
 impl PairStats {
@@ -34,8 +34,8 @@ impl PairStats {
     /// the frames for a window of one frame.
     fn means(&self) -> (f64, f64) {
         match self.first {
-            Some((t0, i0)) if self.last.0 > t0 => {
-                let (t1, i1) = self.last;
+            Some((t0, i0, _)) if self.last.0 > t0 => {
+                let (t1, i1, _) = self.last;
                 let span = t1 - t0;
                 ((i1[0] - i0[0]) / span, (i1[1] - i0[1]) / span)
             }
@@ -46,8 +46,33 @@ impl PairStats {
         }
     }
 
+    /// The root mean squares over time of the normal force and of the
+    /// friction force's magnitude [N]: √(growth of ∫F² dt / length) between
+    /// the window's first and last frames. Over the frames instead for a
+    /// window of one frame, and where ∫F² dt is not finite (forces beyond
+    /// about 1e150 N, whose squares overflow; the frames' sum is scaled).
+    fn rms(&self) -> (f64, f64) {
+        let f = self.frames.max(1) as f64;
+        let frames = (self.normal_squares.rms(f), self.tangential_squares.rms(f));
+        match self.first {
+            Some((t0, _, q0)) if self.last.0 > t0 => {
+                let (t1, _, q1) = self.last;
+                let over_time = |i: usize, fallback: f64| {
+                    let growth = q1[i] - q0[i];
+                    if growth.is_finite() {
+                        (growth.max(0.0) / (t1 - t0)).sqrt()
+                    } else {
+                        fallback
+                    }
+                };
+                (over_time(0, frames.0), over_time(1, frames.1))
+            }
+            _ => frames,
+        }
+    }
+
     /// Adds a frame at `at` [s] with the pair's totals (n, t) [N], its
-    /// impulses and its largest totals since the previous frame
+    /// impulses and ∫F² dt and its largest totals since the previous frame
     /// ([`Frame::peaks`]; both `None` when the simulation does not track
     /// them). The peaks are those of the integrator's stages, the window's
     /// first frame counting with its own totals: the largest over the
@@ -56,12 +81,12 @@ impl PairStats {
         &mut self,
         (n, t): (f64, f64),
         at: f64,
-        impulse: Option<PairTotals>,
+        integrals: Option<(PairTotals, PairTotals)>,
         peak: Option<PairTotals>,
     ) {
-        if let Some(impulse) = impulse {
-            self.first.get_or_insert((at, impulse));
-            self.last = (at, impulse);
+        if let Some((impulse, squares)) = integrals {
+            self.first.get_or_insert((at, impulse, squares));
+            self.last = (at, impulse, squares);
         }
         let [peak_n, peak_t] = peak.filter(|_| self.frames > 0).unwrap_or([n, t]);
         self.frames += 1;
@@ -203,6 +228,9 @@ pub struct Recorder {
     impulses: Vec<PairTotals>,
     /// Each pair's largest totals since the previous frame ([`Frame::peaks`]).
     peaks: Vec<PairTotals>,
+    /// Each pair's ∫F² dt of both totals at the frame [N²·s], for the
+    /// `summary` table's RMS.
+    squares: Vec<PairTotals>,
 }
 
 impl Recorder {
@@ -257,6 +285,7 @@ impl Recorder {
             needs_impulses,
             impulses: Vec::new(),
             peaks: Vec::new(),
+            squares: Vec::new(),
         }
     }
 
@@ -336,6 +365,7 @@ impl Recorder {
         self.evals_current = false;
         if self.needs_impulses {
             dynamics.impulses_at(state.t, &mut self.impulses);
+            dynamics.squares_at(state.t, &mut self.squares);
             dynamics.take_peaks(&mut self.peaks);
             for (k, p) in self.peaks.iter_mut().enumerate() {
                 if p[0] == f64::NEG_INFINITY {
@@ -360,8 +390,9 @@ impl Recorder {
                     if state.t >= start - 1e-12 && state.t <= end + 1e-12 {
                         for (k, s) in self.stats.iter_mut().enumerate() {
                             let impulse = self.impulses.get(k).copied();
+                            let integrals = impulse.zip(self.squares.get(k).copied());
                             let peak = self.peaks.get(k).copied();
-                            s.add(contact_totals(&self.evals, &[k]), state.t, impulse, peak);
+                            s.add(contact_totals(&self.evals, &[k]), state.t, integrals, peak);
                         }
                     }
                 }
@@ -398,8 +429,8 @@ impl Recorder {
                 continue;
             }
             for (k, s) in self.stats.iter().enumerate() {
-                let f = s.frames.max(1) as f64;
                 let (normal_mean, tangential_mean) = s.means();
+                let (normal_rms, tangential_rms) = s.rms();
                 table.push(&[
                     Cell::U32(k as u32),
                     Cell::U32(k as u32),
@@ -408,10 +439,10 @@ impl Recorder {
                     Cell::U64(s.frames),
                     Cell::F64(s.normal_peak),
                     Cell::F64(normal_mean),
-                    Cell::F64(s.normal_squares.rms(f)),
+                    Cell::F64(normal_rms),
                     Cell::F64(s.tangential_peak),
                     Cell::F64(tangential_mean),
-                    Cell::F64(s.tangential_squares.rms(f)),
+                    Cell::F64(tangential_rms),
                 ]);
             }
         }

@@ -357,7 +357,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "normal_rms",
         F64,
         "N",
-        "root mean square of the per-frame total normal force",
+        "root mean square over time of the total normal force in the window: the growth of its integrated square, as the integrator applied the force over its own steps, between the first and the last frame, over their distance (over the frames for a window of one frame)",
     ),
     col(
         "tangential_peak",
@@ -375,7 +375,7 @@ const SUMMARY_COLUMNS: &[ColumnDef] = &[
         "tangential_rms",
         F64,
         "N",
-        "root mean square of the per-frame friction force magnitude",
+        "root mean square over time of the magnitude of the summed friction force, as normal_rms",
     ),
 ];
 
