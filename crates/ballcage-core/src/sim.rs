@@ -8,7 +8,7 @@ use crate::error::{SceneError, SimulationError};
 use crate::integrate::{self, ErrorStats, Stats, Workspace};
 use crate::math::Vec3;
 use crate::model::{Model, Motion, State};
-use crate::record::{Observer, Recorder, Recording};
+use crate::record::{Observer, Recorder, Recording, within_step};
 use crate::scene::{IntegratorKind, Scene};
 
 /// A simulation of one scene.
@@ -817,11 +817,9 @@ impl EnergyBalance {
     /// The input work at time `t` [s]: the sum to the last step's end,
     /// interpolated linearly within that step for a frame inside it.
     fn work_at(&self, t: f64) -> InputWork {
-        let (t0, t1) = self.span;
-        if t >= t1 || t1 <= t0 {
+        let Some(s) = within_step(self.span, t) else {
             return self.work;
-        }
-        let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
+        };
         let (a, b) = (&self.before, &self.work);
         let mix = |x: f64, y: f64| x + s * (y - x);
         InputWork {

@@ -169,46 +169,60 @@ fn the_impulses_do_not_depend_on_the_frames_recorded() {
     lands_and_slides(&coarse);
 }
 
+/// The Hertz impact of the two tests below: a 1 kg ball meeting the floor
+/// at 1 m/s without gravity (Hertz, K = 1e8 N/m^1.5, no damping), over
+/// T = 30 ms with steps of at most 1 ms.
+const IMPACT: (f64, f64, f64, f64) = (1.0, 1.0, 1e8, 0.03); // m [kg], v [m/s], K, T [s]
+
+/// The impact's deepest penetration δ_m [m]: ½mv² = (2/5)K·δ_m^2.5.
+fn impact_depth() -> f64 {
+    let (m, v, k, _) = IMPACT;
+    (5.0 * m * v * v / (4.0 * k)).powf(0.4)
+}
+
+/// The floor–ball pair's `summary` column `column` [N] of the impact
+/// recorded every `every` seconds.
+fn impact_summary(every: f64, column: &str) -> f64 {
+    let (m, v, k, duration) = IMPACT;
+    let text = common::ball_on_floor_toml(
+        &format!(
+            "duration = {duration}\ndt = {every}\noutput_interval = {every}\nmax_step = 1e-3\n\
+             integrator = \"esdirk32\"\nrtol = 1e-6"
+        ),
+        0.0,
+        &format!(
+            "shape = {{ type = \"ball\", radius = 0.05 }}\nmass = {m}\n\
+             position = [0.0, 0.0, 0.0501]\nvelocity = [0.0, 0.0, {}]",
+            -v
+        ),
+        &format!("normal = {{ law = \"hertz\", stiffness = {k} }}"),
+    )
+    .replace("tables = []", "tables = [\"summary\"]");
+    let mut sim = common::sim(&text);
+    sim.run().expect("stable");
+    let rec = sim.finish();
+    let summary = rec.tables.iter().find(|t| t.def.name == "summary");
+    match summary.expect("summary").column(column) {
+        Some(ballcage_core::record::ColumnData::F64(v)) => v[0],
+        other => panic!("{column}: {other:?}"),
+    }
+}
+
 /// The `summary` table's peak is the largest force at any stage of the
-/// integrator's steps, not at a frame: a 1 kg ball meeting the floor at
-/// 1 m/s without gravity (Hertz, K = 1e8 N/m^1.5, no damping) peaks at
-/// K·δ_m^1.5 with ½mv² = (2/5)K·δ_m^2.5, δ_m = (5mv²/4K)^(2/5) = 0.69 mm:
-/// 1 812 N, over a contact of about 2 ms. Recorded every 1 ms and every
-/// 10 ms (the same trajectory: `max_step` fixed), the peak is the same to
-/// the bit and within 0.1 % of it (measured −0.008 %). The peak over the
-/// frames (the summary of commit b203beb) was 0 N with 10 ms frames, the
-/// impact falling between t = 0 and 10 ms, and −2.6 % with 1 ms frames.
+/// integrator's steps, not at a frame: the impact peaks at K·δ_m^1.5,
+/// δ_m = (5mv²/4K)^(2/5) = 0.69 mm: 1 812 N, over a contact of about 2 ms.
+/// Recorded every 1 ms and every 10 ms (the same trajectory: `max_step`
+/// fixed), the peak is the same to the bit and within 0.1 % of it
+/// (measured −0.008 %). The peak over the frames (the summary of commit
+/// b203beb) was 0 N with 10 ms frames, the impact falling between t = 0 and
+/// 10 ms, and −2.6 % with 1 ms frames.
 #[test]
 fn the_summary_peak_is_the_impact_s_whatever_the_frames() {
-    let (m, v, k) = (1.0_f64, 1.0_f64, 1e8_f64);
-    let depth = (5.0 * m * v * v / (4.0 * k)).powf(0.4);
-    let expected = k * depth.powf(1.5);
-    let run = |every: f64| {
-        let text = common::ball_on_floor_toml(
-            &format!(
-                "duration = 0.03\ndt = {every}\noutput_interval = {every}\nmax_step = 1e-3\n\
-                 integrator = \"esdirk32\"\nrtol = 1e-6"
-            ),
-            0.0,
-            "shape = { type = \"ball\", radius = 0.05 }\nmass = 1.0\n\
-             position = [0.0, 0.0, 0.0501]\nvelocity = [0.0, 0.0, -1.0]",
-            "normal = { law = \"hertz\", stiffness = 1e8 }",
-        )
-        .replace("tables = []", "tables = [\"summary\"]");
-        let mut sim = common::sim(&text);
-        sim.run().expect("stable");
-        let rec = sim.finish();
-        let summary = rec
-            .tables
-            .iter()
-            .find(|t| t.def.name == "summary")
-            .expect("summary");
-        match summary.column("normal_peak") {
-            Some(ballcage_core::record::ColumnData::F64(v)) => v[0],
-            other => panic!("normal_peak: {other:?}"),
-        }
-    };
-    let (fine, coarse) = (run(1e-3), run(1e-2));
+    let expected = IMPACT.2 * impact_depth().powf(1.5);
+    let (fine, coarse) = (
+        impact_summary(1e-3, "normal_peak"),
+        impact_summary(1e-2, "normal_peak"),
+    );
     assert_eq!(fine.to_bits(), coarse.to_bits(), "{fine} N, {coarse} N");
     assert!(
         (coarse / expected - 1.0).abs() < 1e-3,
@@ -217,18 +231,17 @@ fn the_summary_peak_is_the_impact_s_whatever_the_frames() {
 }
 
 /// The `summary` table's RMS is a root mean square over time, from ∫F² dt
-/// as the integrator applied the force: the Hertz ball above meets the floor
-/// once, so over the run's T = 30 ms, with δ = δ_m·u^(2/5) and
-/// δ̇ = v·√(1 − u), ∫F² dt = (4/5)·K²·δ_m⁴/v · ∫₀¹ u^(3/5)(1 − u)^(−1/2) du
-/// (the Beta function B(8/5, 1/2) ≈ 1.5134, here by Simpson's rule on
-/// u = 1 − s²), and RMS = √(∫F² dt / T) = 302.3 N. Recorded every 1 ms and
-/// every 10 ms it is the same to 1e-12 and within 0.1 % of that (measured
-/// −0.001 %). The RMS over the frames (commit b203beb) was +5.2 % at 1 ms
-/// frames and 0 N at 10 ms frames.
+/// as the integrator applied the force: the ball meets the floor once, so
+/// over T, with δ = δ_m·u^(2/5) and δ̇ = v·√(1 − u),
+/// ∫F² dt = (4/5)·K²·δ_m⁴/v · ∫₀¹ u^(3/5)(1 − u)^(−1/2) du (the Beta
+/// function B(8/5, 1/2) ≈ 1.5134, here by Simpson's rule on u = 1 − s²),
+/// and RMS = √(∫F² dt / T) = 302.3 N. Recorded every 1 ms and every 10 ms
+/// it is the same to 1e-12 and within 0.1 % of that (measured −0.001 %).
+/// The RMS over the frames (commit b203beb) was +5.2 % at 1 ms frames and
+/// 0 N at 10 ms frames.
 #[test]
 fn the_summary_rms_is_over_time_whatever_the_frames() {
-    let (m, v, k, duration) = (1.0_f64, 1.0_f64, 1e8_f64, 0.03_f64);
-    let depth = (5.0 * m * v * v / (4.0 * k)).powf(0.4);
+    let (_, v, k, duration) = IMPACT;
     // ∫₀¹ u^(3/5)(1 − u)^(−1/2) du = 2∫₀¹ (1 − s²)^(3/5) ds, Simpson on 2·10⁴ panels.
     let n = 20_000;
     let g = |s: f64| (1.0 - s * s).max(0.0).powf(0.6);
@@ -246,29 +259,11 @@ fn the_summary_rms_is_over_time_whatever_the_frames() {
         .sum::<f64>()
         / (3.0 * n as f64);
     let beta = 2.0 * simpson;
-    let expected = (0.8 * k * k * depth.powi(4) / v * beta / duration).sqrt();
-    let run = |every: f64| {
-        let text = common::ball_on_floor_toml(
-            &format!(
-                "duration = {duration}\ndt = {every}\noutput_interval = {every}\nmax_step = 1e-3\n\
-                 integrator = \"esdirk32\"\nrtol = 1e-6"
-            ),
-            0.0,
-            "shape = { type = \"ball\", radius = 0.05 }\nmass = 1.0\n\
-             position = [0.0, 0.0, 0.0501]\nvelocity = [0.0, 0.0, -1.0]",
-            "normal = { law = \"hertz\", stiffness = 1e8 }",
-        )
-        .replace("tables = []", "tables = [\"summary\"]");
-        let mut sim = common::sim(&text);
-        sim.run().expect("stable");
-        let rec = sim.finish();
-        let summary = rec.tables.iter().find(|t| t.def.name == "summary");
-        match summary.expect("summary").column("normal_rms") {
-            Some(ballcage_core::record::ColumnData::F64(v)) => v[0],
-            other => panic!("normal_rms: {other:?}"),
-        }
-    };
-    let (fine, coarse) = (run(1e-3), run(1e-2));
+    let expected = (0.8 * k * k * impact_depth().powi(4) / v * beta / duration).sqrt();
+    let (fine, coarse) = (
+        impact_summary(1e-3, "normal_rms"),
+        impact_summary(1e-2, "normal_rms"),
+    );
     assert!((fine / coarse - 1.0).abs() < 1e-12, "{fine} N, {coarse} N");
     assert!(
         (coarse / expected - 1.0).abs() < 1e-3,

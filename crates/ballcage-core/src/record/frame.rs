@@ -99,6 +99,14 @@ impl PairStats {
     }
 }
 
+/// Where `t` [s] lies within the step `span` (its start and end [s]): the
+/// fraction of the step, for a sum kept at both ends to be interpolated
+/// linearly; `None` at or past its end (or before the first step), where
+/// the sum at the end holds.
+pub(crate) fn within_step((t0, t1): (f64, f64), t: f64) -> Option<f64> {
+    (t < t1 && t1 > t0).then(|| ((t - t0) / (t1 - t0)).clamp(0.0, 1.0))
+}
+
 /// Σx² kept as `scale`²·`ssq` (as LAPACK's dnrm2), so that forces above
 /// 1e154 N, whose squares overflow f64, still give a finite RMS (found by
 /// fuzzing).
@@ -341,12 +349,10 @@ impl Recorder {
     /// What [`Self::after_step`] dissipated until `t` [s]: to the last
     /// step's end, interpolated linearly within that step.
     fn dissipated_at(&self, t: f64) -> Dissipated {
-        let (t0, t1) = self.step_span;
-        if t >= t1 || t1 <= t0 {
-            return self.dissipated;
+        match within_step(self.step_span, t) {
+            Some(s) => self.dissipated.between(&self.dissipated_before, s),
+            None => self.dissipated,
         }
-        let s = ((t - t0) / (t1 - t0)).clamp(0.0, 1.0);
-        self.dissipated.between(&self.dissipated_before, s)
     }
 
     /// Records the frame of `state` at integrator step `step`; `input_work`

@@ -14,6 +14,7 @@ mod observer;
 
 pub use budget::{TableEstimate, bytes_text, check_budget, estimate, frames};
 pub use frame::Recorder;
+pub(crate) use frame::within_step;
 pub use observer::{BodyParts, Frame, Observer, PartIds, Step, contact_totals};
 
 use crate::scene::TableKind;
