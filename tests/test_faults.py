@@ -299,6 +299,21 @@ def test_a_ctrl_c_just_after_a_temporary_is_created_leaves_no_temporary(tmp_path
     assert (tmp_path / "b.txt").read_text() == "earlier"
 
 
+def test_a_temporary_name_another_writer_holds_is_left_to_it(tmp_path: Path, monkeypatch) -> None:
+    """The clean-up removes only the temporaries this writer created: when the hidden name it drew is already
+    taken (O_EXCL), the writer fails with FileExistsError naming the final file, and the other file stays."""
+    from ballcage import _files
+
+    monkeypatch.setattr(_files.secrets, "token_hex", lambda n: "0" * (2 * n))
+    theirs = tmp_path / ".a.txt.00000000.tmp"
+    theirs.write_text("another writer's")
+    with pytest.raises(FileExistsError) as caught:
+        _files.write_all_atomically({tmp_path / "a.txt": lambda p: p.write_text("a")})
+    assert caught.value.filename == str(tmp_path / "a.txt")
+    assert theirs.read_text() == "another writer's"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [theirs.name]
+
+
 # --------------------------------------------------------------------------- full disk
 
 

@@ -45,13 +45,13 @@ def write_all_atomically(files: Mapping[Path, Callable[[Path], object]]) -> None
     try:
         for final, write in files.items():
             # Listed before it exists, so that a Ctrl-C landing between its creation and the listing cannot leave
-            # it behind (the clean-up tolerates a name never created); unlisted again if the name was taken.
+            # it behind (the clean-up tolerates a name never created); unlisted again only if the name was taken.
             tmp = final.with_name(f".{final.name}.{secrets.token_hex(4)}.tmp")
             temporaries.append((tmp, final))
             try:
                 _create_temporary(tmp, final)
-            except OSError:
-                temporaries.pop()  # another writer's file, or none: not ours to remove
+            except FileExistsError:
+                temporaries.pop()  # another writer's temporary: not ours to remove
                 raise
             _fill(tmp, final, write)
         for tmp, final in temporaries:
