@@ -2,7 +2,7 @@
 """The ideal-CV chain at a loose setting: error of its summed mean tube force and real-time factor, in draws.
 
     python3 scripts/ideal_cv_draws.py [--duration S] [--window A B] [--rtol R] [--set KEY=VALUE ...]
-                                      [--out FILE.json] [--references EARLIER.json]
+                                      [--out FILE.json] [--references EARLIER.json] [--verify {1,2}]
 
 Runs the embedded paper scene with ``pipe.hinge="ideal-cv"`` (docs/performance.md, "What limits the
 ideal-CV chain at loose tolerances"):
@@ -15,7 +15,11 @@ ideal-CV chain at loose tolerances"):
 
 Prints each run's summed mean tube force (``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s),
 its difference from the SDIRK2 reference, the real-time factor of the run's metadata and its force
-evaluations. Takes about 20 s on this project's machine (17 s on 2026-11-27, 08:00:46-08:01:03 UTC; the SDIRK2
+evaluations. With ``--verify 1`` or ``--verify 2`` each draw is run with ``simulate(..., verify=...)``, and
+the table adds what the verification says of the sum: its measured error (against the rtol/10 run) and, with
+2, the rtol/10 run's own error as the rtol/100 run measures it and whether that confirms the measured error
+(`ballcage.verify.CONFIRM_RULE`), beside the true error against the reference; and whether the verdict over
+every headline quantity is confirmed. Takes about 20 s on this project's machine (17 s on 2026-11-27, 08:00:46-08:01:03 UTC; the SDIRK2
 reference is most of it), 4 s with ``--references``.
 """
 
@@ -44,17 +48,24 @@ RTOL = 3e-2
 SCALES = (0.9, 0.95, 0.97, 1.0, 1.03, 1.05, 1.1)
 
 
-def measure(overrides: list[str], duration: float, window: tuple[float, float]) -> dict:
-    """One ideal-CV run: its summed mean tube force [N], real-time factor and force evaluations."""
+def measure(overrides: list[str], duration: float, window: tuple[float, float], verify: int = 0) -> dict:
+    """One ideal-CV run: its summed mean tube force [N], real-time factor and force evaluations; with `verify`, what
+    its verification says of the sum and overall."""
     common = ['pipe.hinge="ideal-cv"', f"simulation.duration={duration}", f"record.summary_window=[{window[0]}, {window[1]}]"]
-    run = ballcage.simulate({"kind": "drill-pipe"}, overrides=[*common, *overrides], progress=False)
+    run = ballcage.simulate({"kind": "drill-pipe"}, overrides=[*common, *overrides], progress=False, verify=verify)
     meta = run.metadata
-    return {
+    out = {
         "overrides": overrides,
         "sum_n": headline(run)[QUANTITY][1],
         "real_time_factor": float(meta["ballcage.real_time_factor"]),
         "force_evaluations": int(meta["ballcage.force_evaluations"]),
     }
+    if run.verification is not None:
+        row = next(r for r in run.verification.table.to_pylist() if r["quantity"] == QUANTITY)
+        out |= {key: row[key] for key in ("rel_difference", "confirm_rel_difference", "confirmed")}
+        out["verdict_confirmed"] = run.verification.confirmed
+        out["time_ratio"] = run.verification.time_ratio
+    return out
 
 
 def main() -> None:
@@ -65,6 +76,7 @@ def main() -> None:
     parser.add_argument("--set", action="append", default=None, metavar="KEY=VALUE", help="the loose setting, besides rtol")
     parser.add_argument("--rtol", type=float, default=RTOL, help=f"the loose setting's middle rtol (default {RTOL})")
     parser.add_argument("--references", metavar="FILE.json", help="reuse the references of an earlier --out (same duration and window)")
+    parser.add_argument("--verify", type=int, choices=(1, 2), default=0, help="verify each draw (1: at rtol/10; 2: also at rtol/100)")
     args = parser.parse_args()
     window = (args.window[0], args.window[1])
     loose = LOOSE if args.set is None else args.set
@@ -79,14 +91,20 @@ def main() -> None:
     other = refs["ESDIRK3(2) rtol 1e-6"]["sum_n"]
     print(f"references: SDIRK2 25 µs {ref:.2f} N, ESDIRK3(2) rtol 1e-6 {other:.2f} N ({100 * abs(other - ref) / ref:.3f} % apart)")
     print(f"setting: rtol {args.rtol:g} x scale, {' '.join(loose)}")
-    print("| rtol | sum [N] | error | real-time factor | force evaluations |")
-    print("|---:|---:|---:|---:|---:|")
+    checked = " verified error | rtol/10 run's own error | sum confirmed | verdict confirmed | verification time |"
+    print("| rtol | sum [N] | error | real-time factor | force evaluations |" + (checked if args.verify else ""))
+    print("|---:|---:|---:|---:|---:|" + ("---:|---:|---|---|---:|" if args.verify else ""))
     draws = []
     for scale in SCALES:
-        d = measure([f"simulation.rtol={args.rtol * scale:.6g}", *loose], args.duration, window)
+        d = measure([f"simulation.rtol={args.rtol * scale:.6g}", *loose], args.duration, window, args.verify)
         d["error"] = abs(d["sum_n"] - ref) / ref
         draws.append(d)
-        print(f"| {args.rtol * scale:.4g} | {d['sum_n']:.2f} | {100 * d['error']:.3f} % | {d['real_time_factor']:.1f} | {d['force_evaluations']} |")
+        line = f"| {args.rtol * scale:.4g} | {d['sum_n']:.2f} | {100 * d['error']:.3f} % | {d['real_time_factor']:.1f} | {d['force_evaluations']} |"
+        if args.verify:
+            own = "" if d["confirm_rel_difference"] is None else f"{100 * d['confirm_rel_difference']:.3f} %"
+            ratio = "" if d["time_ratio"] is None else f"{d['time_ratio']:.1f}x"
+            line += f" {100 * d['rel_difference']:.3f} % | {own} | {d['confirmed']} | {d['verdict_confirmed']} | {ratio} |"
+        print(line)
     errors = [d["error"] for d in draws]
     factors = [d["real_time_factor"] for d in draws]
     print(f"error {100 * min(errors):.3f}-{100 * max(errors):.3f} %, real-time factor {min(factors):.1f}-{max(factors):.1f} (median {statistics.median(factors):.1f})")

@@ -17,7 +17,8 @@ and `SweepError`, `ballcage.verify.VerificationError` (a `SimulationError`)
 and `ballcage.run.TimeLimitError` (a run past ``simulate(..., time_limit=)``).
 ``ballcage.simulate(scene, verify=True)`` repeats the run ten times tighter
 and keeps the difference of each headline quantity as the run's measured
-error, ``run.verification`` (``ballcage run --verify``; `ballcage.verify`).
+error, ``run.verification`` (``ballcage run --verify``; `ballcage.verify`);
+``verify=2`` adds a run a hundred times tighter that checks the first.
 All quantities are SI; units are in each output column's field metadata.
 
 The paper's drill pipe is built in: `ballcage.scene.default_scene()` is its scene, and

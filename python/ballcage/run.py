@@ -70,8 +70,18 @@ class Verification:
     largest: float | None
     #: The quantity of `largest`.
     quantity: str | None
-    #: Wall time of the verification run over the run's (``ballcage.wall_time_s``); ``None`` if not measured.
+    #: Wall time of the verification run (with ``verify=2`` both) over the run's (``ballcage.wall_time_s``); ``None``
+    #: if not measured.
     time_ratio: float | None
+    #: ``verify=2``: the second verification run's setting, ``"rtol/100"`` or ``"dt/16"``; ``None`` without one.
+    confirm_setting: str | None = None
+    #: ``verify=2``: the largest relative difference between the two verification runs: the first one's own error.
+    confirm_largest: float | None = None
+    #: The quantity of `confirm_largest`.
+    confirm_quantity: str | None = None
+    #: ``verify=2``: whether the second run confirms the first (`ballcage.verify.CONFIRM_RULE`); ``None`` without a
+    #: second run or a difference to judge.
+    confirmed: bool | None = None
 
 
 class VerificationError(_native.SimulationError):
@@ -116,8 +126,8 @@ class TimeLimitError(_native.Error, TimeoutError):
 class Verifier(Protocol):
     """What ``simulate(..., verify=True)`` needs of `ballcage.verify` (`VERIFIER`)."""
 
-    def start(self, scene: _native.Scene, progress: bool | None) -> Any:
-        """Starts the verification run of `scene` beside its run; returns a handle for `finish`."""
+    def start(self, scene: _native.Scene, progress: bool | None, runs: int) -> Any:
+        """Starts the `runs` verification runs (1 or 2) of `scene` beside its run; returns a handle for `finish`."""
 
     def finish(self, run: Run, progress: bool | None, started: Any) -> Verification:
         """The `Verification` of the complete `run` from the verification run `started`."""
@@ -280,7 +290,7 @@ def simulate(
     *,
     overrides: Iterable[str] = (),
     progress: bool | None = None,
-    verify: bool = False,
+    verify: bool | int = False,
     time_limit: float | None = None,
 ) -> Run:
     """Runs a scene to its duration and returns the recorded tables.
@@ -297,6 +307,11 @@ def simulate(
     drill pipe's comparison quantities and a generic scene's summary
     statistics, so a scene that does not record the ``summary`` table records
     it too. The verification run shows its own progress bar.
+    ``verify=2`` adds a second verification run, a hundred times tighter
+    (``rtol/100``, ``dt/16`` for SDIRK2), which checks the first: where the
+    first is itself off by more than a third of the error it measures, the
+    measured error is not confirmed (``Verification.confirmed``; the rule is
+    `ballcage.verify.CONFIRM_RULE`).
 
     Raises `ballcage.SceneError` for an invalid scene and
     `ballcage.SimulationError` when the run diverges. The error then carries
@@ -317,10 +332,11 @@ def simulate(
     """
     if time_limit is not None and not (math.isfinite(time_limit) and time_limit > 0):
         raise _native.InputError(f"time_limit = {time_limit!r}: must be a positive number of seconds (None: no limit)")
-    resolved = _resolved(scene, overrides, verify)
-    if not verify:
+    runs = verification_runs(verify)
+    resolved = _resolved(scene, overrides, runs)
+    if not runs:
         return _run(resolved, progress, time_limit)
-    return _verified(resolved, progress, time_limit, _nothing)[0]
+    return _verified(resolved, progress, time_limit, _nothing, runs)[0]
 
 
 def simulate_then(
@@ -329,7 +345,7 @@ def simulate_then(
     *,
     overrides: Iterable[str] = (),
     progress: bool | None = None,
-    verify: bool = False,
+    verify: bool | int = False,
 ) -> tuple[Run, T]:
     """`simulate`, with `work(run)` done on the complete run while its verification run goes on beside it.
 
@@ -341,17 +357,29 @@ def simulate_then(
     fails raises its `VerificationError` after `work`, carrying the run as
     ``e.run`` and what `work` returned as ``e.done``.
     """
-    resolved = _resolved(scene, overrides, verify)
-    if not verify:
+    runs = verification_runs(verify)
+    resolved = _resolved(scene, overrides, runs)
+    if not runs:
         run = _run(resolved, progress)
         return run, work(run)
-    return _verified(resolved, progress, None, work)
+    return _verified(resolved, progress, None, work, runs)
 
 
-def _resolved(scene: SceneSource, overrides: Iterable[str], verify: bool) -> _native.Scene:
-    """The validated scene of `simulate`: with `verify`, recording ``summary`` (the headline quantities need it)."""
+def verification_runs(verify: bool | int) -> int:
+    """How many verification runs `simulate`'s `verify` asks for: 0, 1 (``True``) or 2."""
+    if isinstance(verify, int) and verify in (0, 1, 2):  # a bool is an int
+        return int(verify)
+    raise _native.InputError(
+        f"verify = {verify!r}: must be False, True (one verification run, ten times tighter) or 2 (a second, a "
+        "hundred times tighter, checks the first)"
+    )
+
+
+def _resolved(scene: SceneSource, overrides: Iterable[str], runs: int) -> _native.Scene:
+    """The validated scene of `simulate`: with `runs` verification runs, recording ``summary`` (the headline
+    quantities need it)."""
     resolved = load_scene(scene, overrides)
-    if verify and "summary" not in resolved.table_names:
+    if runs and "summary" not in resolved.table_names:
         resolved = load_scene(resolved, ["record.tables=" + json.dumps([*resolved.table_names, "summary"])])
     return resolved
 
@@ -361,12 +389,12 @@ def _nothing(run: Run) -> None:
 
 
 def _verified(
-    resolved: _native.Scene, progress: bool | None, time_limit: float | None, work: Callable[[Run], T]
+    resolved: _native.Scene, progress: bool | None, time_limit: float | None, work: Callable[[Run], T], runs: int
 ) -> tuple[Run, T]:
-    """The run of `resolved` and `work` on it, its verification run going on beside both (`VERIFIER`)."""
+    """The run of `resolved` and `work` on it, its `runs` verification runs going on beside both (`VERIFIER`)."""
     if VERIFIER is None:  # the facade sets it on `import ballcage`, which any import of ballcage.run runs first
         raise _native.InternalError("ballcage.run.VERIFIER is not set: import ballcage to verify a run")
-    started = VERIFIER.start(resolved, progress)
+    started = VERIFIER.start(resolved, progress, runs)
     try:
         run = _run(resolved, progress, time_limit)
         done = work(run)

@@ -45,8 +45,8 @@ class Tighter:
 ATOL_KEYS = ("atol", "atol_position", "atol_rotation", "atol_velocity", "atol_angular_velocity")
 
 
-def tighter(scene: _native.Scene) -> Tighter:
-    """The verification run's setting: the scene's error bound ten times tighter.
+def tighter(scene: _native.Scene, times: int = 1) -> Tighter:
+    """The verification run's setting: the scene's error bound ten times tighter, `times` over (1 or 2).
 
     - Adaptive steps (a positive ``simulation.rtol``; ESDIRK3(2)): ``rtol/10``,
       and each absolute tolerance the scene sets (``simulation.atol`` and the
@@ -57,26 +57,33 @@ def tighter(scene: _native.Scene) -> Tighter:
       by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
       step, so the frames are the same.
 
+    ``times=2`` applies the rule twice (``rtol/100``, ``dt/16`` for sdirk2): the
+    second verification run of ``verify=2``, which checks the first.
+
     Every other field (the Newton tolerance, ``max_steps``) is kept: a
     ``max_steps`` the d times more steps exceed makes the verification fail.
     """
+    if times not in (1, 2):
+        raise _native.InputError(f"tighter: times = {times!r} is not 1 or 2 (the verification runs of verify=1 or 2)")
     simulation = scene.value("simulation")
     rtol = simulation.get("rtol")
     if rtol:
-        overrides = [f"simulation.rtol={rtol / TIGHTER!r}"]
+        factor = TIGHTER**times
+        overrides = [f"simulation.rtol={rtol / factor!r}"]
         for key in ATOL_KEYS:
             if simulation.get(key) is not None:
-                overrides.append(f"simulation.{key}={simulation[key] / TIGHTER!r}")
-        return Tighter(f"rtol/{TIGHTER}", tuple(overrides))
+                overrides.append(f"simulation.{key}={simulation[key] / factor!r}")
+        return Tighter(f"rtol/{factor}", tuple(overrides))
     name = simulation["integrator"]
     order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
-    d = math.ceil(TIGHTER ** (1.0 / order))
+    d = math.ceil(TIGHTER ** (1.0 / order)) ** times
     return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
 
 
 def cost_factor(label: str) -> float:
     """How many runs a verification run at the setting `label` (`Tighter.label`) costs: d for ``dt/d``; for
-    ``rtol/10``, 10^(1/3), since ESDIRK3(2)'s steps grow as the tolerance^(-1/3); the largest of several labels
+    ``rtol/f``, f^(1/3), since ESDIRK3(2)'s steps grow as the tolerance^(-1/3); the largest of several labels
     (``"rtol/10, dt/4"``, a sweep whose cases differ)."""
-    factors = [float(x.removeprefix("dt/")) if x.startswith("dt/") else TIGHTER ** (1.0 / 3.0) for x in label.split(", ")]
+    factors = [float(x.removeprefix("dt/")) if x.startswith("dt/") else float(x.removeprefix("rtol/")) ** (1.0 / 3.0)
+               for x in label.split(", ")]  # fmt: skip
     return max(factors)
