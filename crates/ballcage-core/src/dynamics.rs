@@ -18,6 +18,7 @@ use nalgebra::Vector6;
 use table::{ContactTable, PairSlots};
 
 mod impulse;
+pub mod quasistatic;
 mod table;
 
 /// Accelerations of every body (zero for bodies that are not integrated).
