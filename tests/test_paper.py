@@ -122,7 +122,10 @@ def test_figures_are_real_pngs_of_nontrivial_size(paper_out, figure):
 def test_comparison_has_exactly_the_reference_keys_columns_and_types(paper_out):
     out, _ = paper_out
     table = pq.read_table(out / "comparison.parquet")
-    assert table.column_names == ["key", "paper", "ours", "unit", "ratio", "note", "numerical_error", "numerical_error_rel"]
+    assert table.column_names == [
+        "key", "paper", "ours", "unit", "ratio", "note", "numerical_error", "numerical_error_rel",
+        "numerical_error_confirmed",
+    ]  # fmt: skip
     types = {f.name: f.type for f in table.schema}
     assert types == {
         "key": pa.string(),
@@ -133,7 +136,9 @@ def test_comparison_has_exactly_the_reference_keys_columns_and_types(paper_out):
         "note": pa.string(),
         "numerical_error": pa.float64(),
         "numerical_error_rel": pa.float64(),
+        "numerical_error_confirmed": pa.bool_(),
     }
+    assert table.column("numerical_error_confirmed").null_count == table.num_rows  # one verification run
     shipped = _reference_quantities()
     expected = _expected_rows()
     assert len(expected) == len(shipped) + len(EXTRA_ROWS)
@@ -223,6 +228,31 @@ def test_each_row_s_numerical_error_is_its_difference_to_the_run_ten_times_tight
     text = (out / "comparison.md").read_text(encoding="utf-8")
     largest = max((r["numerical_error_rel"], r["key"]) for r in rows if r["numerical_error_rel"] is not None)
     assert f"on `{largest[1]}`" in text and "Numerical error: each row's |ours − ours of the same run" in text
+
+
+def test_paper_verify_2_confirms_each_row_s_error_by_a_run_a_hundred_times_tighter(tmp_path):
+    out, duration = tmp_path / "p", ["simulation.duration=0.05"]
+    proc = _cli("paper", "--out", str(out), "--set", duration[0], "--verify", "2")
+    assert proc.returncode == 0, proc.stderr
+    rows = pq.read_table(out / "comparison.parquet").to_pylist()
+    # By hand: the rtol/10 and rtol/100 runs, each compared with the paper on its own; the rule of CONFIRM_RULE.
+    tight = paper.comparison(ballcage.simulate(paper.paper_scene([*duration, "simulation.rtol=1e-05"]), progress=False))
+    tighter = paper.comparison(ballcage.simulate(paper.paper_scene([*duration, "simulation.rtol=1e-06"]), progress=False))
+    floors = {"N": 1.0, "deg": 0.1, "mm": 1.0}
+    judged = {True: 0, False: 0}
+    for row, b, c in zip(rows, tight.to_pylist(), tighter.to_pylist(), strict=True):
+        if row["numerical_error_rel"] is None:
+            assert row["numerical_error_confirmed"] is None, row["key"]
+            continue
+        own = abs(b["ours"] - c["ours"]) / max(abs(c["ours"]), floors[row["unit"]])
+        assert row["numerical_error_confirmed"] == (own <= max(row["numerical_error_rel"] / 3, 1e-9)), row["key"]
+        judged[row["numerical_error_confirmed"]] += 1
+    assert judged[True] >= 10  # most rows are confirmed at this short, smooth start
+    text = (out / "comparison.md").read_text(encoding="utf-8")
+    assert "A second run at rtol/100" in text and "--verify 2" in text.split("```")[1]
+    assert "confirmed at rtol/100" in proc.stdout or "error NOT MEASURED" in proc.stdout
+    both = _cli("paper", "--out", str(tmp_path / "q"), "--verify", "2", "--no-verify")
+    assert both.returncode == 2 and "--verify 2 and --no-verify: choose one" in both.stderr
 
 
 def test_paper_without_verification_leaves_the_column_empty_and_says_so(tmp_path):

@@ -56,6 +56,11 @@ def add(commands: Commands) -> None:
         "--no-verify", action="store_true",
         help="do not repeat the run ten times tighter: the comparison's numerical error column stays empty",
     )  # fmt: skip
+    paper.add_argument(
+        "--verify", type=int, choices=(1, 2), default=None, metavar="RUNS",
+        help="verification runs (default 1: the run ten times tighter, each row's numerical error); 2 adds a run a "
+        "hundred times tighter that confirms each row's error or not, as ballcage run --verify 2",
+    )  # fmt: skip
     add_quiet_option(paper, "no progress bar and no summary")
     paper.set_defaults(command=command)
 
@@ -81,7 +86,7 @@ def command(args: argparse.Namespace) -> int:
         with scheduler_client(args.scheduler) as client:
             paths = run_paper(
                 out, overrides, sweeps=args.sweeps, progress=False if args.quiet else None, workers=args.workers,
-                client=client, sensitivity=args.sensitivity, verify=not args.no_verify,
+                client=client, sensitivity=args.sensitivity, verify=_verification_runs(args),
             )
     except VerificationError as e:
         failure, paths = e, e.written  # type: ignore[attr-defined]  # run_paper wrote everything else
@@ -102,6 +107,13 @@ def command(args: argparse.Namespace) -> int:
     if failure is not None:
         return fail(f"{failure}; the report in {out} is complete without the numerical error column", 1)
     return 0
+
+
+def _verification_runs(args: argparse.Namespace) -> int:
+    """`run_paper`'s `verify` from ``--verify RUNS`` and ``--no-verify``."""
+    if args.no_verify and args.verify is not None:
+        raise UsageError(f"--verify {args.verify} and --no-verify: choose one")
+    return 0 if args.no_verify else args.verify or 1
 
 
 def _verdict(path: Path) -> str:

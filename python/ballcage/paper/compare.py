@@ -96,6 +96,10 @@ ERROR_FIELDS: dict[str, tuple[pa.DataType, str, str]] = {
                         "unit as unit); null where not verified (a sweep row, or --no-verify)"),
     "numerical_error_rel": (pa.float64(), "1", "numerical_error / max(|ours of the tighter run|, the unit's floor) "
                             "(verify.parquet's rel_difference); null where numerical_error is, and for an index"),
+    "numerical_error_confirmed": (pa.bool_(), "", "with --verify 2: whether a run a hundred times tighter confirms "
+                                  "numerical_error_rel, the tighter run's own error at most a third of it "
+                                  "(verify.parquet's confirmed); null with one verification run and where "
+                                  "numerical_error_rel is"),
 }  # fmt: skip
 
 
@@ -473,7 +477,7 @@ def with_numerical_error(table: pa.Table, verification: Verification | None) -> 
     schema metadata (``ballcage.verify.setting``, ``ballcage.verify.overrides``).
     """
     rows = {r["quantity"]: r for r in verification.table.to_pylist()} if verification is not None else {}
-    columns: dict[str, list[float | None]] = {name: [] for name in ERROR_FIELDS}
+    columns: dict[str, list[float | bool | None]] = {name: [] for name in ERROR_FIELDS}
     for row in table.select(["key", "unit"]).to_pylist():
         name = sensitivity_quantity(row["key"])
         found = rows.get(name) if name is not None else None
@@ -481,12 +485,15 @@ def with_numerical_error(table: pa.Table, verification: Verification | None) -> 
             found = None
         columns["numerical_error"].append(found["abs_difference"] if found is not None else None)
         columns["numerical_error_rel"].append(found["rel_difference"] if found is not None else None)
+        columns["numerical_error_confirmed"].append(found.get("confirmed") if found is not None else None)
     for name, (kind, unit, description) in ERROR_FIELDS.items():
         field = pa.field(name, kind, metadata={"description": description, "unit": unit})
         table = table.append_column(field, pa.array(columns[name], type=kind))
     if verification is None:
         return table
     meta = {"ballcage.verify.setting": verification.setting, "ballcage.verify.overrides": json.dumps(verification.overrides)}
+    if verification.confirm_setting is not None:
+        meta["ballcage.verify.confirm_setting"] = verification.confirm_setting
     return table.replace_schema_metadata({**(table.schema.metadata or {}), **meta})
 
 

@@ -12,7 +12,7 @@ from ballcage.paper.compare import PHASES_KEY, fmt
 from ballcage.paper.definitions import EXTRA_ROWS, REFERENCE_FILE, SWEEPS, reference
 from ballcage.paper.places import place_lines
 from ballcage.measures.phases import scene_facts
-from ballcage.run import Run
+from ballcage.run import Run, Verification
 
 __all__ = ["comparison_markdown", "duty_lines"]
 
@@ -96,7 +96,8 @@ def _error_cell(row: Mapping[str, Any]) -> str:
     """A row's numerical-error cell: relative in per cent, an index's difference as a count, "—" where not verified."""
     rel, difference = row["numerical_error_rel"], row["numerical_error"]
     if rel is not None:
-        return f"{fmt(100.0 * rel, 2)} % | "
+        unconfirmed = " (not confirmed)" if row.get("numerical_error_confirmed") is False else ""
+        return f"{fmt(100.0 * rel, 2)} %{unconfirmed} | "
     if difference is None:
         return "— | "
     if row["unit"] in ("", "1", None):  # an index: the runs agree or name another part
@@ -124,7 +125,30 @@ def _error_paragraph(table: pa.Table, run: Run | None, unverified: str | None) -
         if verification is not None and verification.time_ratio is not None:
             text += f"; the verification took {fmt(verification.time_ratio, 2)}× the run's time"
         text += "."
+    if verification is not None and verification.confirm_setting is not None:
+        text += " " + _confirmation(verification)
     return text
+
+
+def _confirmation(verification: Verification) -> str:
+    """What the second verification run (``--verify 2``) says of the first, over every headline quantity of
+    ``verify.parquet`` (the comparison rows and the per-link ones)."""
+    first, second = verification.setting, verification.confirm_setting
+
+    def percent(x: float | None) -> str:
+        return "?" if x is None else f"{fmt(100.0 * x, 2)} %"
+
+    own, largest = percent(verification.confirm_largest), percent(verification.largest)
+    scope = f"over the {verification.table.num_rows} headline quantities of `verify.parquet`"
+    if verification.confirmed:
+        return (f"A second run at {second} confirms it: {scope} the {first} run is within {own} of it, at most a "
+                f"third of the largest error it measures there ({largest}); a row marked \"not confirmed\" has "
+                "too small an error for the second run to confirm on its own, and is still within the largest plus "
+                f"the {first} run's own ({largest} + {own}).")  # fmt: skip
+    return (f"**A second run at {second} does not confirm it**: {scope} the {first} run is itself {own} from it "
+            f"(on `{verification.confirm_quantity}`), more than a third of the largest error it measures there "
+            f"({largest}), so the column understates this run's error (docs/accuracy.md, \"A verification that "
+            "checks itself\").")  # fmt: skip
 
 
 def _spread_cells(row: Mapping[str, Any]) -> str:

@@ -49,7 +49,7 @@ def run_paper(
     workers: int | None = None,
     client: Any = None,
     sensitivity: str | os.PathLike[str] | None = None,
-    verify: bool = True,
+    verify: bool | int = True,
 ) -> dict[str, Path]:
     """Runs the paper scene and writes tables, figures and the comparison into `out_dir`.
 
@@ -79,7 +79,8 @@ def run_paper(
     (`ballcage.paper.compare.with_spread`; null, "—" in ``comparison.md``, where the study has no such quantity).
 
     With `verify` the run is repeated ten times tighter (as ``ballcage run --verify``) and every row gains its
-    measured numerical error (`ballcage.paper.compare.with_numerical_error`). If that run fails, the rest is
+    measured numerical error (`ballcage.paper.compare.with_numerical_error`); ``verify=2`` repeats it a hundred
+    times tighter too, which confirms each row's error or not (as ``ballcage run --verify 2``). If that run fails, the rest is
     written and its `ballcage.run.VerificationError` raised last, the written paths as ``e.written``. Raises
     `ballcage.SceneError` for an invalid override, `ballcage.InputError` for a
     sensitivity table that cannot be read, and `ballcage.SimulationError`
@@ -122,7 +123,7 @@ def run_paper(
 
 
 def _run_and_write(
-    scene: _native.Scene, out: Path, progress: bool | None, verify: bool
+    scene: _native.Scene, out: Path, progress: bool | None, verify: bool | int
 ) -> tuple[Run, dict[str, Path], str, VerificationError | None]:
     """The paper run, its tables and `_write_derived`'s files, written while its verification run goes on
     (`simulate_then`), and ``verify.parquet``; returns the run, the written paths, the derived Markdown and a
@@ -214,7 +215,7 @@ def paper_scene(overrides: Iterable[str] = ()) -> _native.Scene:
 
 
 def _command_line(
-    out: Path, overrides: Sequence[str], sweeps: bool, sensitivity: str | os.PathLike[str] | None, verify: bool
+    out: Path, overrides: Sequence[str], sweeps: bool, sensitivity: str | os.PathLike[str] | None, verify: bool | int
 ) -> str:
     args = ["ballcage", "paper", "--out", str(out)]
     for o in overrides:
@@ -225,4 +226,6 @@ def _command_line(
         args += ["--sensitivity", os.fspath(sensitivity)]
     if not verify:
         args.append("--no-verify")
+    elif verify == 2:
+        args += ["--verify", "2"]
     return shlex.join(args)
