@@ -15,6 +15,11 @@
 //! without friction, so a body may be free in position only
 //! ([`StaticDofs::Position`]).
 //!
+//! [`condensed_stiffness`] gives what the held bodies feel of the free
+//! ones' equilibrium as they move: the Schur complement of the free bodies'
+//! stiffness (the implicit function theorem), the Jacobian a quasi-static
+//! hinge hands to the global Newton iterations.
+//!
 //! Each Newton step solves (K_ff − λ·I)·Δ = −f over the free coordinates
 //! (K is negative where a force restores, so −λ adds stiffness), λ a 1e-9
 //! of K_ff's largest diagonal entry: a direction with no stiffness (a cage
@@ -170,6 +175,52 @@ pub fn equilibrium(
         tol.max_iterations,
         largest_parts(free, &offset, &f).0
     ))
+}
+
+/// The stiffness of the `held` bodies' net wrenches against their own
+/// poses (world δx and δθ, six coordinates per held body in their order;
+/// N/m, N/rad, N·m/m, N·m/rad) with the `free` bodies kept in equilibrium
+/// as the held ones move: a quasi-static hinge's Jacobian for the global
+/// Newton iterations. By the implicit function theorem, as f_f(q_f, q_h) =
+/// 0 holds, δq_f = −K_ff⁻¹·K_fh·δq_h and
+///
+/// K_c = K_hh − K_hf·K_ff⁻¹·K_fh,
+///
+/// the Schur complement of the free bodies' stiffness, each block of K over
+/// every force on its bodies. `state` should be an equilibrium of the free
+/// bodies ([`equilibrium`]); an error where their stiffness is singular.
+pub fn condensed_stiffness(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    state: &State,
+    free: &[(usize, StaticDofs)],
+    held: &[usize],
+) -> Result<DMatrix<f64>, String> {
+    let mut offset = vec![None; model.bodies.len()];
+    let mut n = 0;
+    let held_poses: Vec<(usize, StaticDofs)> =
+        held.iter().map(|&b| (b, StaticDofs::Pose)).collect();
+    for &(body, dofs) in free.iter().chain(&held_poses) {
+        offset[body] = Some((n, dofs));
+        n += dofs.dim();
+    }
+    let (n_free, n_held) = (n - 6 * held.len(), 6 * held.len());
+    let (mut with_k, mut without_k) = (VelocityJacobian::new(model), VelocityJacobian::new(model));
+    dynamics.forces_and_jacobian(model, state, Mode::Trial, 0.0, &mut without_k);
+    dynamics.forces_and_jacobian(model, state, Mode::Trial, 1.0, &mut with_k);
+    let k = stiffness(&with_k, &without_k, &offset, n);
+    if n_free == 0 {
+        return Ok(k);
+    }
+    let k_ff = k.view((0, 0), (n_free, n_free)).into_owned();
+    let k_fh = k.view((0, n_free), (n_free, n_held)).into_owned();
+    let moved = k_ff.lu().solve(&k_fh).ok_or_else(|| {
+        format!(
+            "the stiffness of the {} free bodies is singular",
+            free.len()
+        )
+    })?;
+    Ok(k.view((n_free, n_free), (n_held, n_held)) - k.view((n_free, 0), (n_held, n_free)) * moved)
 }
 
 /// The net wrenches on the free bodies at `state`, stacked as their
