@@ -448,3 +448,14 @@ def test_cli_run_verify_2_ends_with_the_confirmed_error_and_refuses_3(tmp_path, 
         cli.main(["run", str(TWO_BALLS), "--verify", "3", "--out", str(tmp_path / "three")])
     assert exit_info.value.code == 2
     assert "--verify: invalid choice: 3" in capsys.readouterr().err
+
+
+def test_a_second_verification_run_that_fails_is_named_and_stops_nothing_else(tmp_path, capsys):
+    # 1 000 steps of 100 us; the dt/4 run's 4 000 fit simulation.max_steps = 5 000, the dt/16 run's 16 000 do not.
+    out = tmp_path / "out"
+    argv = ["run", str(TWO_BALLS), "--verify", "2", "--out", str(out), "--set", SDIRK2, "--set", f"simulation.dt={COARSE}",
+            "--set", "simulation.max_steps=5000"]  # fmt: skip
+    assert cli.main(argv) == 1
+    err = capsys.readouterr().err
+    assert "the verification run at dt/16 failed" in err and "simulation.max_steps" in err
+    assert (out / "contacts.parquet").exists() and not (out / "verify.parquet").exists()

@@ -43,7 +43,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
 from ballcage import _native
-from ballcage.run import ProgressBar, Run, Verification, VerificationError, run_watched, simulate
+from ballcage.run import Cancelled, ProgressBar, Run, Verification, VerificationError, run_watched, simulate
 from ballcage.studies.refinement import TIGHTER, Tighter, tighter
 
 if TYPE_CHECKING:
@@ -146,14 +146,15 @@ class Started:
 
     def outcomes(self, progress: bool | None) -> list[Run | BaseException]:
         """Each verification run, complete, or what it raised; waits for them with a bar of their own (`progress`,
-        at the slower one's time)."""
+        at the slower one's time). One that fails stops the other: its outcome is then `Cancelled`."""
         if any(thread.is_alive() for thread in self._threads):
             bar = ProgressBar(progress, self._duration)
             try:
-                for thread in self._threads:
-                    while thread.is_alive():
-                        thread.join(0.1)
-                        bar.update(min(self._t))
+                while alive := [thread for thread in self._threads if thread.is_alive()]:
+                    if any(isinstance(outcome, BaseException) for outcome in self._outcomes):
+                        self._stop.set()
+                    alive[0].join(0.1)
+                    bar.update(min(self._t))
             finally:
                 bar.close()
         assert all(outcome is not None for outcome in self._outcomes)  # the threads have ended
@@ -208,6 +209,10 @@ def verify(
     checks: list[Run] = []
     try:
         done = started.outcomes(progress) if started is not None else None
+        failed = [(s, o) for s, o in zip(settings, done or ()) if isinstance(o, BaseException)]
+        if failed:  # what failed, not the run it stopped (`Cancelled`)
+            setting, outcome = next(((s, o) for s, o in failed if not isinstance(o, Cancelled)), failed[0])
+            raise outcome
         for i, setting in enumerate(settings):
             outcome = done[i] if done is not None else simulate(run.scene, overrides=setting.overrides, progress=progress)
             if isinstance(outcome, BaseException):
