@@ -78,6 +78,9 @@ def test_a_fixed_step_is_divided_by_the_ceiling_of_ten_to_one_over_the_order(int
     assert check.dt == pytest.approx(scene.dt / d, rel=1e-12)
     assert check.output_interval == scene.output_interval
     assert check.duration == scene.duration
+    # the Newton iterations' own error a tenth where the stages are solved by Newton
+    newton = 1e-6 if integrator in ("sdirk2", "esdirk32") else 1e-5
+    assert check.value("simulation.newton.tolerance") == pytest.approx(newton, rel=1e-12)
     # the bound C·dt^p falls at least tenfold, and the next smaller divisor would not be enough
     order = {"symplectic-euler": 1, "linearly-implicit-euler": 1, "sdirk2": 2, "esdirk32": 3, "rk4": 4}[integrator]
     assert d == math.ceil(10 ** (1 / order))
@@ -158,7 +161,8 @@ def test_verify_parquet_holds_the_table_the_setting_and_both_wall_times(runs, tm
     assert table.num_rows == 6  # six force statistics of the one pair
     meta = {k.decode(): v.decode() for k, v in table.schema.metadata.items()}
     assert meta["ballcage.verify.setting"] == "dt/4"
-    assert meta["ballcage.verify.overrides"] == '["simulation.dt=2.5e-05"]'
+    # the step a quarter, SDIRK2's Newton tolerance (1e-5 by default) a tenth
+    assert meta["ballcage.verify.overrides"] == '["simulation.dt=2.5e-05", "simulation.newton.tolerance=1e-06"]'
     assert float(meta["ballcage.verify.check_dt_s"]) == pytest.approx(COARSE / 4)
     ratio = float(meta["ballcage.verify.check_wall_time_s"]) / float(meta["ballcage.verify.run_wall_time_s"])
     assert ratio == pytest.approx(run.verification.time_ratio)
@@ -197,7 +201,7 @@ def test_a_failed_verification_run_exits_1_and_keeps_the_runs_tables(tmp_path, c
     err = capsys.readouterr().err
     assert code == 1
     first, last = err.strip().splitlines()
-    assert first == "ballcage: verifying: the run again at dt/4 (simulation.dt=2.5e-05)"
+    assert first == "ballcage: verifying: the run again at dt/4 (simulation.dt=2.5e-05, simulation.newton.tolerance=1e-06)"
     assert last.startswith("ballcage: error: the verification run at dt/4 failed: ")
     assert "simulation.max_steps" in last and "verify.parquet was not written" in last
     bodies = pq.read_table(out / "bodies.parquet")
@@ -382,9 +386,9 @@ def test_a_second_verification_run_confirms_the_first_where_its_error_falls_with
     for name in ONCE_RESOLVED:
         assert 0 < rows[name]["confirm_difference"] < rows[name]["abs_difference"] / 4, name
         assert rows[name]["confirmed"] is True
-    # the second run is the scene at dt/16, as run alone
-    alone = ballcage.simulate(TWO_BALLS, overrides=[SDIRK2, f"simulation.dt={COARSE / 16!r}", 'record.tables=["summary"]'],
-                              progress=False)  # fmt: skip
+    # the second run is the scene at dt/16 (and a hundredth of the Newton tolerance), as run alone
+    scene = ballcage.load_scene(TWO_BALLS, [SDIRK2, f"simulation.dt={COARSE!r}", 'record.tables=["summary"]'])
+    alone = ballcage.simulate(scene, overrides=tighter(scene, 2).overrides, progress=False)
     assert rows["normal_peak[impact]"]["confirm_value"] == ballcage.verify.headline(alone)["normal_peak[impact]"][1]
     assert v.confirmed is True and v.confirm_largest is not None
     assert v.confirm_largest <= v.largest / 3

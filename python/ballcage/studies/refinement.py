@@ -41,6 +41,8 @@ class Tighter:
         return out
 
 
+#: The integrators whose stages are solved by Newton iterations to ``simulation.newton.tolerance``.
+NEWTON_INTEGRATORS = ("sdirk2", "esdirk32")
 #: The absolute tolerances of ``[simulation]``: ``atol`` and one per quantity.
 ATOL_KEYS = ("atol", "atol_position", "atol_rotation", "atol_velocity", "atol_angular_velocity")
 
@@ -55,13 +57,16 @@ def tighter(scene: _native.Scene, times: int = 1) -> Tighter:
       (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
       dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
       by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
-      step, so the frames are the same.
+      step, so the frames are the same. The Newton iterations of sdirk2 and
+      esdirk32 stop at ``simulation.newton.tolerance`` whatever the step, an
+      error of their own: it is divided by 10 as well. (With adaptive steps
+      they stop at min(tolerance, rtol/10), which follows rtol.)
 
     ``times=2`` applies the rule twice (``rtol/100``, ``dt/16`` for sdirk2): the
     second verification run of ``verify=2``, which checks the first.
 
-    Every other field (the Newton tolerance, ``max_steps``) is kept: a
-    ``max_steps`` the d times more steps exceed makes the verification fail.
+    Every other field (``max_steps`` among them) is kept: a ``max_steps`` the
+    d times more steps exceed makes the verification fail.
     """
     if times not in (1, 2):
         raise _native.InputError(f"tighter: times = {times!r} is not 1 or 2 (the verification runs of verify=1 or 2)")
@@ -77,7 +82,11 @@ def tighter(scene: _native.Scene, times: int = 1) -> Tighter:
     name = simulation["integrator"]
     order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
     d = math.ceil(TIGHTER ** (1.0 / order)) ** times
-    return Tighter(f"dt/{d}", (f"simulation.dt={simulation['dt'] / d!r}",))
+    overrides = [f"simulation.dt={simulation['dt'] / d!r}"]
+    if name in NEWTON_INTEGRATORS:
+        newton = scene.value("simulation.newton.tolerance")
+        overrides.append(f"simulation.newton.tolerance={newton / TIGHTER**times:.6g}")
+    return Tighter(f"dt/{d}", tuple(overrides))
 
 
 def cost_factor(label: str) -> float:
