@@ -196,6 +196,25 @@ pub fn condensed_stiffness(
     free: &[(usize, StaticDofs)],
     held: &[usize],
 ) -> Result<DMatrix<f64>, String> {
+    let (k, n_free) = partitioned(model, dynamics, state, free, held);
+    let n_held = k.nrows() - n_free;
+    if n_free == 0 {
+        return Ok(k);
+    }
+    let k_fh = k.view((0, n_free), (n_free, n_held)).into_owned();
+    let moved = solve_free(&k, n_free, free.len(), k_fh)?;
+    Ok(k.view((n_free, n_free), (n_held, n_held)) - k.view((n_free, 0), (n_held, n_free)) * moved)
+}
+
+/// K over the `free` bodies' coordinates and then the `held` bodies' poses
+/// (6 each) at `state`, and the number of free coordinates.
+fn partitioned(
+    model: &Model,
+    dynamics: &mut Dynamics,
+    state: &State,
+    free: &[(usize, StaticDofs)],
+    held: &[usize],
+) -> (DMatrix<f64>, usize) {
     let mut offset = vec![None; model.bodies.len()];
     let mut n = 0;
     let held_poses: Vec<(usize, StaticDofs)> =
@@ -204,23 +223,28 @@ pub fn condensed_stiffness(
         offset[body] = Some((n, dofs));
         n += dofs.dim();
     }
-    let (n_free, n_held) = (n - 6 * held.len(), 6 * held.len());
     let (mut with_k, mut without_k) = (VelocityJacobian::new(model), VelocityJacobian::new(model));
     dynamics.forces_and_jacobian(model, state, Mode::Trial, 0.0, &mut without_k);
     dynamics.forces_and_jacobian(model, state, Mode::Trial, 1.0, &mut with_k);
-    let k = stiffness(&with_k, &without_k, &offset, n);
-    if n_free == 0 {
-        return Ok(k);
-    }
-    let k_ff = k.view((0, 0), (n_free, n_free)).into_owned();
-    let k_fh = k.view((0, n_free), (n_free, n_held)).into_owned();
-    let moved = k_ff.lu().solve(&k_fh).ok_or_else(|| {
-        format!(
-            "the stiffness of the {} free bodies is singular",
-            free.len()
-        )
-    })?;
-    Ok(k.view((n_free, n_free), (n_held, n_held)) - k.view((n_free, 0), (n_held, n_free)) * moved)
+    (
+        stiffness(&with_k, &without_k, &offset, n),
+        n - 6 * held.len(),
+    )
+}
+
+/// K_ff⁻¹·`rhs`, K_ff the leading `n_free` block of `k` (of `bodies` free
+/// bodies); an error where it is singular.
+fn solve_free(
+    k: &DMatrix<f64>,
+    n_free: usize,
+    bodies: usize,
+    rhs: DMatrix<f64>,
+) -> Result<DMatrix<f64>, String> {
+    k.view((0, 0), (n_free, n_free))
+        .into_owned()
+        .lu()
+        .solve(&rhs)
+        .ok_or_else(|| format!("the stiffness of the {bodies} free bodies is singular"))
 }
 
 /// The net wrenches on the free bodies at `state`, stacked as their
