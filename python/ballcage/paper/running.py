@@ -80,8 +80,9 @@ def run_paper(
 
     With `verify` the run is repeated ten times tighter (as ``ballcage run --verify``) and every row gains its
     measured numerical error (`ballcage.paper.compare.with_numerical_error`); ``verify=2`` repeats it a hundred
-    times tighter too, which confirms each row's error or not (as ``ballcage run --verify 2``). If that run fails, the rest is
-    written and its `ballcage.run.VerificationError` raised last, the written paths as ``e.written``. Raises
+    times tighter too, which confirms each row's error or not (as ``ballcage run --verify 2``). If a verification
+    run fails, the rest is written and its `ballcage.run.VerificationError` raised last, the written paths as
+    ``e.written``. Raises
     `ballcage.SceneError` for an invalid override, `ballcage.InputError` for a
     sensitivity table that cannot be read, and `ballcage.SimulationError`
     when the main run diverges (a sweep case that diverges is recorded in the

@@ -128,12 +128,9 @@ pub fn equilibrium(
         state.vel[body] = Vec3::zeros();
         state.omega[body] = Vec3::zeros();
     }
-    let (mut with_k, mut without_k) = (VelocityJacobian::new(model), VelocityJacobian::new(model));
     let mut f = residual(model, dynamics, state, free, n)?;
     for iteration in 1..=tol.max_iterations {
-        dynamics.forces_and_jacobian(model, state, Mode::Trial, 0.0, &mut without_k);
-        dynamics.forces_and_jacobian(model, state, Mode::Trial, 1.0, &mut with_k);
-        let k = stiffness(&with_k, &without_k, &offset, n);
+        let (k, _) = partitioned(model, dynamics, state, free, &[]);
         let largest = k.diagonal().iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let damped = &k - DMatrix::identity(n, n) * (1e-9 * largest);
         // K·Δ = −f with K = ∂f/∂q: Δ = −K⁻¹·f.
@@ -244,6 +241,7 @@ fn solve_free(
         .into_owned()
         .lu()
         .solve(&rhs)
+        .filter(|x| x.iter().all(|v| v.is_finite()))
         .ok_or_else(|| format!("the stiffness of the {bodies} free bodies is singular"))
 }
 
