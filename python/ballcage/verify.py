@@ -252,19 +252,27 @@ def verify(
         "ballcage.verify.largest_quantity": quantity or "",
     }
     if len(checks) == 2:
-        meta |= {
-            "ballcage.verify.confirm_setting": settings[1].label,
-            "ballcage.verify.confirm_overrides": json.dumps(settings[1].overrides),
-            "ballcage.verify.confirm_wall_time_s": checks[1].metadata.get("ballcage.wall_time_s", ""),
-            "ballcage.verify.confirm_largest_relative": "" if confirm_largest is None else repr(confirm_largest),
-            "ballcage.verify.confirm_largest_quantity": confirm_quantity or "",
-            "ballcage.verify.confirmed": "" if confirmed is None else str(confirmed).lower(),
-            "ballcage.verify.confirm_rule": CONFIRM_RULE,
-        }
+        meta |= _confirm_metadata(settings[1], checks[1], (confirm_largest, confirm_quantity), confirmed)
     return Verification(
         table.replace_schema_metadata(meta), setting.label, setting.overrides, largest, quantity, ratio,
         settings[1].label if len(checks) == 2 else None, confirm_largest, confirm_quantity, confirmed,
     )  # fmt: skip
+
+
+def _confirm_metadata(
+    setting: Tighter, check: Run, largest: tuple[float | None, str | None], confirmed: bool | None
+) -> dict[str, str]:
+    """The schema metadata of ``verify.parquet`` on the second verification run (`setting`, `check`): its largest
+    ``confirm_rel_difference`` and quantity, and whether it confirms the first (`CONFIRM_RULE`)."""
+    return {
+        "ballcage.verify.confirm_setting": setting.label,
+        "ballcage.verify.confirm_overrides": json.dumps(setting.overrides),
+        "ballcage.verify.confirm_wall_time_s": check.metadata.get("ballcage.wall_time_s", ""),
+        "ballcage.verify.confirm_largest_relative": "" if largest[0] is None else repr(largest[0]),
+        "ballcage.verify.confirm_largest_quantity": largest[1] or "",
+        "ballcage.verify.confirmed": "" if confirmed is None else str(confirmed).lower(),
+        "ballcage.verify.confirm_rule": CONFIRM_RULE,
+    }
 
 
 def confirms(largest: float | None, confirm_largest: float | None) -> bool | None:

@@ -78,11 +78,10 @@ def run_paper(
     its quantity over the study's runs and the parameter with the largest effect
     (`ballcage.paper.compare.with_spread`; null, "—" in ``comparison.md``, where the study has no such quantity).
 
-    With `verify` the run is repeated ten times tighter (as ``ballcage run --verify``) and every row gains its
-    measured numerical error (`ballcage.paper.compare.with_numerical_error`); ``verify=2`` repeats it a hundred
-    times tighter too, which confirms each row's error or not (as ``ballcage run --verify 2``). If a verification
-    run fails, the rest is written and its `ballcage.run.VerificationError` raised last, the written paths as
-    ``e.written``. Raises
+    With `verify` the run is repeated ten times tighter (``ballcage run --verify``), and every row gains its
+    measured numerical error (`ballcage.paper.compare.with_numerical_error`); ``verify=2`` also a hundred times
+    tighter, which confirms each row's error or not. If a verification run fails, the rest is written and its
+    `ballcage.run.VerificationError` raised last, the written paths as ``e.written``. Raises
     `ballcage.SceneError` for an invalid override, `ballcage.InputError` for a
     sensitivity table that cannot be read, and `ballcage.SimulationError`
     when the main run diverges (a sweep case that diverges is recorded in the
