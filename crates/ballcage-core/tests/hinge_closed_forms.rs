@@ -515,6 +515,24 @@ fn key_forces(sim: &Simulation, state: &State, h: usize) -> Vec<(f64, f64, f64)>
         .collect()
 }
 
+/// Hinge `h`'s cage (free in its pose, first) and six keys (free in their
+/// positions) for `dynamics::quasistatic`, and the state of `sim` at rest, as
+/// the hand statics are (the settled links still creep by µm/s).
+fn hinge_at_rest(sim: &Simulation, h: usize) -> (Vec<(usize, StaticDofs)>, State) {
+    let mut free = vec![(
+        common::body(sim, &format!("h{h:02}.cage")),
+        StaticDofs::Pose,
+    )];
+    free.extend((0..6).map(|j| {
+        let key = common::body(sim, &format!("h{h:02}.key{j}"));
+        (key, StaticDofs::Position)
+    }));
+    let mut state = sim.state().clone();
+    state.vel.fill(Vec3::zeros());
+    state.omega.fill(Vec3::zeros());
+    (free, state)
+}
+
 /// Issue 28's local solve (`dynamics::quasistatic::equilibrium`): hinge 0's
 /// cage (its pose) and keys (their positions) moved off the settled state of
 /// the dynamic model (the cage by 4 µm and 0.01° about the pipe axis, each
@@ -534,18 +552,12 @@ fn the_cage_and_keys_solved_for_equilibrium_carry_the_settled_forces_and_the_han
     for (extra, stiff, far) in [(&[STIFF][..], true, 1.0), (&[][..], false, 10.0)] {
         let (chain, sim, _) = loaded_link(1000.0, torque, extra);
         let settled = key_forces(&sim, sim.state(), 0);
-        let cage = common::body(&sim, "h00.cage");
-        let keys: Vec<usize> = (0..6)
-            .map(|j| common::body(&sim, &format!("h00.key{j}")))
-            .collect();
-        // At rest, as the hand statics are (the settled links still creep by µm/s).
-        let mut state = sim.state().clone();
-        state.vel.fill(Vec3::zeros());
-        state.omega.fill(Vec3::zeros());
+        let (free, mut state) = hinge_at_rest(&sim, 0);
+        let (cage, keys) = (free[0].0, &free[1..]);
         state.pos[cage] += far * Vec3::new(4e-6, -3e-6, 2e-6);
         let axis = state.rot[chain[0]] * Vec3::x();
         state.rot[cage] = Quat::from_scaled_axis(axis * 1.7e-4 * far) * state.rot[cage];
-        for (j, &key) in keys.iter().enumerate() {
+        for (j, &(key, _)) in keys.iter().enumerate() {
             let psi = j as f64 * std::f64::consts::FRAC_PI_3;
             state.pos[key] += far * Vec3::new(3e-6, 5e-6 * psi.cos(), -4e-6 * psi.sin());
         }
@@ -561,8 +573,6 @@ fn the_cage_and_keys_solved_for_equilibrium_carry_the_settled_forces_and_the_han
             "the start is off the settled forces: {}",
             off(&moved)
         );
-        let mut free = vec![(cage, StaticDofs::Pose)];
-        free.extend(keys.iter().map(|&k| (k, StaticDofs::Position)));
         let model = sim.model();
         let mut dynamics = Dynamics::new(model);
         let solve = equilibrium(
@@ -621,19 +631,9 @@ fn condensed_against_differences(extra: &[&str]) {
     const ARM: f64 = 0.03;
     let (chain, sim, _) = loaded_link(1000.0, 1800.0, extra);
     let model = sim.model();
-    let cage = common::body(&sim, "h00.cage");
-    let mut free = vec![(cage, StaticDofs::Pose)];
-    free.extend((0..6).map(|j| {
-        (
-            common::body(&sim, &format!("h00.key{j}")),
-            StaticDofs::Position,
-        )
-    }));
+    let (free, mut rest) = hinge_at_rest(&sim, 0);
     let held = [chain[0], chain[1]];
     let mut dynamics = Dynamics::new(model);
-    let mut rest = sim.state().clone();
-    rest.vel.fill(Vec3::zeros());
-    rest.omega.fill(Vec3::zeros());
     equilibrium(
         model,
         &mut dynamics,
