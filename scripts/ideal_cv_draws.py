@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """The ideal-CV chain at a loose setting: error of its summed mean tube force and real-time factor, in draws.
 
-    python3 scripts/ideal_cv_draws.py [--duration S] [--window A B] [--rtol R] [--set KEY=VALUE ...]
-                                      [--out FILE.json] [--references EARLIER.json] [--verify {1,2}]
+    python3 scripts/ideal_cv_draws.py [--duration S] [--window A B] [--rtol R] [--integrator NAME]
+                                      [--set KEY=VALUE ...] [--out FILE.json] [--references EARLIER.json]
+                                      [--verify {1,2}]
 
 Runs the embedded paper scene with ``pipe.hinge="ideal-cv"`` (docs/performance.md, "What limits the
 ideal-CV chain at loose tolerances"):
@@ -10,10 +11,11 @@ ideal-CV chain at loose tolerances"):
 - two references by different methods, SDIRK2 at 25 µs and ESDIRK3(2) at rtol 1e-6, 33 samples per link;
   their difference is the reference's own error;
 - the setting given by ``--set`` (default: rtol 3e-2, steps up to 20 ms, Newton 3e-3, 3 samples per link,
-  frames every 10 ms) seven times, its rtol scaled by 0.9, 0.95, 0.97, 1, 1.03, 1.05 and 1.1: a change no
+  frames every 10 ms) with ``--integrator`` (default the scene's, ESDIRK3(2); ``trbdf2`` for TR-BDF2) seven times, its rtol scaled by 0.9, 0.95, 0.97, 1, 1.03, 1.05 and 1.1: a change no
   result should care about, so the spread of the seven is what one run of that setting is worth.
 
-Prints each run's summed mean tube force (``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s),
+A draw whose run fails (``ballcage.SimulationError``: diverged, a step it cannot take) is listed with its
+message and counted, and the others go on. Prints each run's summed mean tube force (``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s),
 its difference from the SDIRK2 reference, the real-time factor of the run's metadata and its force
 evaluations. With ``--verify 1`` or ``--verify 2`` each draw is run with ``simulate(..., verify=...)``, and
 the table adds what the verification says of the sum: its measured error (against the rtol/10 run) and, with
@@ -76,11 +78,14 @@ def main() -> None:
     parser.add_argument("--out", default="out/ideal_cv_draws.json", help="where the raw results go (out/ is not tracked)")
     parser.add_argument("--set", action="append", default=None, metavar="KEY=VALUE", help="the loose setting, besides rtol")
     parser.add_argument("--rtol", type=float, default=RTOL, help=f"the loose setting's middle rtol (default {RTOL})")
+    parser.add_argument("--integrator", help="simulation.integrator of the draws (default the scene's, esdirk32)")
     parser.add_argument("--references", metavar="FILE.json", help="reuse the references of an earlier --out (same duration and window)")
     parser.add_argument("--verify", type=int, choices=(1, 2), default=0, help="verify each draw (1: at rtol/10; 2: also at rtol/100)")
     args = parser.parse_args()
     window = (args.window[0], args.window[1])
     loose = LOOSE if args.set is None else args.set
+    if args.integrator:
+        loose = [f'simulation.integrator="{args.integrator}"', *loose]
     if args.references:
         earlier = json.loads(Path(args.references).read_text())
         if tuple(earlier["window"]) != window or earlier.get("duration") != args.duration:
@@ -95,9 +100,14 @@ def main() -> None:
     checked = " verified error | rtol/10 run's own error | sum confirmed | verdict confirmed | verification time |"
     print("| rtol | sum [N] | error | real-time factor | force evaluations |" + (checked if args.verify else ""))
     print("|---:|---:|---:|---:|---:|" + ("---:|---:|---|---|---:|" if args.verify else ""))
-    draws = []
+    draws, failed = [], []
     for scale in SCALES:
-        d = measure([f"simulation.rtol={args.rtol * scale:.6g}", *loose], args.duration, window, args.verify)
+        try:
+            d = measure([f"simulation.rtol={args.rtol * scale:.6g}", *loose], args.duration, window, args.verify)
+        except ballcage.SimulationError as e:
+            failed.append({"rtol": args.rtol * scale, "message": str(e)})
+            print(f"| {args.rtol * scale:.4g} | failed: {str(e)[:110]}… | | | |")
+            continue
         d["error"] = abs(d["sum_n"] - ref) / ref
         draws.append(d)
         line = f"| {args.rtol * scale:.4g} | {d['sum_n']:.2f} | {100 * d['error']:.3f} % | {d['real_time_factor']:.1f} | {d['force_evaluations']} |"
@@ -108,10 +118,13 @@ def main() -> None:
         print(line)
     errors = [d["error"] for d in draws]
     factors = [d["real_time_factor"] for d in draws]
-    print(f"error {100 * min(errors):.3f}-{100 * max(errors):.3f} %, real-time factor {min(factors):.1f}-{max(factors):.1f} (median {statistics.median(factors):.1f})")
+    if draws:
+        print(f"error {100 * min(errors):.3f}-{100 * max(errors):.3f} %, real-time factor {min(factors):.1f}-{max(factors):.1f} (median {statistics.median(factors):.1f})")
+    print(f"{len(failed)} of {len(SCALES)} draws failed")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps({"references": refs, "draws": draws, "window": window, "duration": args.duration}, indent=1))
+    result = {"references": refs, "draws": draws, "failed": failed, "window": window, "duration": args.duration}
+    out.write_text(json.dumps(result, indent=1))
 
 
 if __name__ == "__main__":

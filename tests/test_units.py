@@ -159,4 +159,6 @@ def test_scene_show_lists_the_optional_tolerances_while_they_are_unset():
     fixed = ballcage.Scene.from_toml('kind = "drill-pipe"', ["simulation.rtol=0"]).to_toml(units=True)
     assert "rtol = 0.0  # -" in fixed and "# max_step: unset" in fixed
     generic = ballcage.Scene.from_toml(EXAMPLES[0].read_text(encoding="utf-8")).to_toml(units=True)
-    assert "# rtol: unset, relative tolerance of esdirk32's adaptive steps (absent or 0: fixed steps of dt) [-]" in generic
+    assert (
+        "# rtol: unset, relative tolerance of esdirk32's and trbdf2's adaptive steps (absent or 0: fixed steps of dt) [-]"
+    ) in generic

@@ -68,7 +68,14 @@ def _rows(run: ballcage.Run) -> dict[str, dict]:
 
 @pytest.mark.parametrize(
     ("integrator", "d"),
-    [("symplectic-euler", 10), ("linearly-implicit-euler", 10), ("sdirk2", 4), ("esdirk32", 3), ("rk4", 2)],
+    [
+        ("symplectic-euler", 10),
+        ("linearly-implicit-euler", 10),
+        ("sdirk2", 4),
+        ("trbdf2", 4),
+        ("esdirk32", 3),
+        ("rk4", 2),
+    ],
 )
 def test_a_fixed_step_is_divided_by_the_ceiling_of_ten_to_one_over_the_order(integrator, d):
     scene = ballcage.load_scene(TWO_BALLS, [f'simulation.integrator="{integrator}"'])
@@ -79,16 +86,18 @@ def test_a_fixed_step_is_divided_by_the_ceiling_of_ten_to_one_over_the_order(int
     assert check.output_interval == scene.output_interval
     assert check.duration == scene.duration
     # the Newton iterations' own error a tenth where the stages are solved by Newton
-    newton = 1e-6 if integrator in ("sdirk2", "esdirk32") else 1e-5
+    newton = 1e-6 if integrator in ("sdirk2", "trbdf2", "esdirk32") else 1e-5
     assert check.value("simulation.newton.tolerance") == pytest.approx(newton, rel=1e-12)
     # the bound C·dt^p falls at least tenfold, and the next smaller divisor would not be enough
-    order = {"symplectic-euler": 1, "linearly-implicit-euler": 1, "sdirk2": 2, "esdirk32": 3, "rk4": 4}[integrator]
+    order = {"symplectic-euler": 1, "linearly-implicit-euler": 1, "sdirk2": 2, "trbdf2": 2, "esdirk32": 3, "rk4": 4}
+    order = order[integrator]
     assert d == math.ceil(10 ** (1 / order))
     assert d**order >= 10 > (d - 1) ** order
 
 
-def test_adaptive_steps_tighten_rtol_and_a_set_atol_tenfold_and_keep_dt():
-    adaptive = ['simulation.integrator="esdirk32"', "simulation.rtol=1e-3"]
+@pytest.mark.parametrize("integrator", ["esdirk32", "trbdf2"])
+def test_adaptive_steps_tighten_rtol_and_a_set_atol_tenfold_and_keep_dt(integrator):
+    adaptive = [f'simulation.integrator="{integrator}"', "simulation.rtol=1e-3"]
     scene = ballcage.load_scene(TWO_BALLS, adaptive)
     assert tighter(scene).label == "rtol/10"
     check = ballcage.load_scene(scene, tighter(scene).overrides)

@@ -122,7 +122,9 @@ class Scene:
         """Interval between recorded frames [s]."""
 
     @property
-    def integrator(self) -> Literal["symplectic-euler", "rk4", "linearly-implicit-euler", "sdirk2"]: ...
+    def integrator(
+        self,
+    ) -> Literal["symplectic-euler", "rk4", "linearly-implicit-euler", "sdirk2", "esdirk32", "trbdf2"]: ...
     @property
     def table_names(self) -> list[str]:
         """Tables the scene records, e.g. ``["bodies", "contacts"]``."""

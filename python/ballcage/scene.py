@@ -76,7 +76,7 @@ class SceneBuilder:
     ) -> Self:
         """Time stepping: `duration`, `dt` and `output_interval` [s], `integrator` name, and
         `threads` evaluating the contact pairs (default 1; results are bitwise the same for any count).
-        With ``integrator="esdirk32"``, `rtol` [–] sets the adaptive steps' relative tolerance
+        With ``integrator="esdirk32"`` or ``"trbdf2"``, `rtol` [–] sets the adaptive steps' relative tolerance
         (0: fixed steps of `dt`) and `max_step` [s] the longest step (default the output interval)."""
         given = {
             "duration": duration,

@@ -208,7 +208,7 @@ impl Simulation {
         self.workspace.stats()
     }
 
-    /// What the error-estimating integrator (`esdirk32`) did: accepted and
+    /// What the error-estimating integrators (`esdirk32`, `trbdf2`) did: accepted and
     /// rejected steps, the smallest step, the accumulated error estimate;
     /// `None` for the other integrators.
     pub fn error_stats(&self) -> Option<ErrorStats> {
@@ -448,7 +448,7 @@ impl Simulation {
         out
     }
 
-    /// The metadata of an integrator with an error estimate (`esdirk32`):
+    /// The metadata of an integrator with an error estimate (`esdirk32`, `trbdf2`):
     /// accepted and rejected steps, the accumulated estimate of the global
     /// error (the sums of each step's largest local error on a position
     /// [m] and on a velocity [m/s]) and the tolerances; empty otherwise.
@@ -568,7 +568,7 @@ impl Simulation {
             }
             // No stability limit on the linearized contacts: resolve the
             // stiffest contact's period instead.
-            IntegratorKind::Sdirk2 | IntegratorKind::Esdirk32 => {
+            IntegratorKind::Sdirk2 | IntegratorKind::Esdirk32 | IntegratorKind::Trbdf2 => {
                 let (period, pair) = w.period();
                 (
                     period / 10.0,

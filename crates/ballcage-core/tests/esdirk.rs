@@ -1,7 +1,10 @@
-//! The ESDIRK3(2)4L[2]SA integrator (`esdirk32`): observed order 3 on a
+//! The ESDIRK pairs: ESDIRK3(2)4L[2]SA (`esdirk32`), observed order 3 on a
 //! linear and on nonlinear problems with known solutions, order 2 of its
 //! embedded error estimate, a stiff problem whose fast scale the steps do
-//! not resolve, and adaptive steps whose error follows the tolerance.
+//! not resolve, and adaptive steps whose error follows the tolerance; and
+//! TR-BDF2 (`trbdf2`), which shares its stages and controller, the same for
+//! its order 2 and its estimate of the error of the solution it goes on
+//! with.
 
 mod common;
 
@@ -17,8 +20,13 @@ fn oscillator(dt: f64, extra: &str) -> Simulation {
 
 /// [`oscillator`] with frames every `output_interval` [s].
 fn oscillator_framed(dt: f64, output_interval: f64, extra: &str) -> Simulation {
+    oscillator_by("esdirk32", dt, output_interval, extra)
+}
+
+/// [`oscillator_framed`] with `integrator`.
+fn oscillator_by(integrator: &str, dt: f64, output_interval: f64, extra: &str) -> Simulation {
     common::oscillator(&format!(
-        "dt = {dt}\noutput_interval = {output_interval}\nintegrator = \"esdirk32\"\n\
+        "dt = {dt}\noutput_interval = {output_interval}\nintegrator = \"{integrator}\"\n\
          newton = {{ tolerance = 1e-13 }}\n{extra}"
     ))
 }
@@ -83,12 +91,12 @@ fn third_order_on_the_rotation_manifold() {
 /// Hertz law (F = K·δ^1.5, no damping), released from its rest depth with
 /// 0.02 m/s downwards: it oscillates without leaving the floor, and its
 /// energy ½mv² + K·δ^2.5/2.5 − m·g·δ is conserved (docs/model.md §2.1).
-fn hertz(dt: f64) -> Simulation {
+fn hertz(integrator: &str, dt: f64) -> Simulation {
     let (m, k, g) = (0.014f64, 1e9f64, 100.0 / 0.014);
     let rest = (m * g / k).powf(1.0 / 1.5);
     common::ball_on_floor(
         &format!(
-            "duration = 0.01\ndt = {dt}\noutput_interval = 0.01\nintegrator = \"esdirk32\"\n\
+            "duration = 0.01\ndt = {dt}\noutput_interval = 0.01\nintegrator = \"{integrator}\"\n\
              newton = {{ tolerance = 1e-14 }}"
         ),
         g,
@@ -104,13 +112,13 @@ fn hertz(dt: f64) -> Simulation {
 }
 
 /// The relative energy error at the end of a Hertz run.
-fn hertz_energy_error(dt: f64) -> f64 {
+fn hertz_energy_error(integrator: &str, dt: f64) -> f64 {
     let (m, k, g) = (0.014f64, 1e9f64, 100.0 / 0.014);
     let energy = |z: f64, v: f64| {
         let d = (0.0075 - z).max(0.0);
         0.5 * m * v * v + k * d.powf(2.5) / 2.5 + m * g * (z - 0.0075)
     };
-    let mut sim = hertz(dt);
+    let mut sim = hertz(integrator, dt);
     let i = common::body(&sim, "ball");
     let s0 = sim.state().clone();
     let e0 = energy(s0.pos[i].z, s0.vel[i].z);
@@ -129,7 +137,7 @@ fn third_order_on_a_hertz_contact() {
     // 2.5 µs resolve it (hω 0.22 to 0.055).
     let errors: Vec<f64> = [1e-5, 5e-6, 2.5e-6]
         .iter()
-        .map(|&dt| hertz_energy_error(dt))
+        .map(|&dt| hertz_energy_error("esdirk32", dt))
         .collect();
     let p = orders(&errors);
     eprintln!("hertz energy errors {errors:?}, orders {p:?}");
@@ -356,11 +364,17 @@ fn tolerances_need_the_integrator_with_an_estimate() {
         ("sdirk2", "rtol = 1e-5", "simulation.rtol"),
         ("esdirk32", "atol = 1e-5", "simulation.atol"),
         ("esdirk32", "rtol = -1.0", "simulation.rtol"),
+        ("trbdf2", "atol = 1e-5", "simulation.atol"),
     ] {
         let e = ballcage_core::Scene::from_toml_str(&base(integrator, extra), &[])
             .expect_err(extra)
             .to_string();
         assert!(e.contains(field), "{integrator}, {extra}: {e}");
+    }
+    // Both pairs estimate their error, so both take adaptive steps.
+    for integrator in ["esdirk32", "trbdf2"] {
+        ballcage_core::Scene::from_toml_str(&base(integrator, "rtol = 1e-5"), &[])
+            .unwrap_or_else(|e| panic!("{integrator}: {e}"));
     }
     // Fixed steps by default: no adaptive metadata beyond the estimate.
     let mut sim = common::sim(&base("esdirk32", ""));
@@ -464,8 +478,13 @@ fn prothero_robinson_errors(integrator: &str) -> Vec<f64> {
 /// any `friction` after it), under `esdirk32` with
 /// the `[simulation]` keys `simulation` (0.1 s).
 fn landing(normal: &str, simulation: &str) -> Simulation {
+    landing_by("esdirk32", normal, simulation)
+}
+
+/// [`landing`] with `integrator`.
+fn landing_by(integrator: &str, normal: &str, simulation: &str) -> Simulation {
     common::ball_on_floor(
-        &format!("duration = 0.1\nintegrator = \"esdirk32\"\n{simulation}"),
+        &format!("duration = 0.1\nintegrator = \"{integrator}\"\n{simulation}"),
         9.81,
         "shape = { type = \"ball\", radius = 0.05 }\nmass = 1.0\n\
          position = [0.0, 0.0, 0.0499]\nvelocity = [0.05, 0.0, -0.2]",
@@ -600,4 +619,126 @@ fn the_paper_scene_takes_at_most_two_newton_iterations_per_stage() {
         e.accepted,
         e.rejected
     );
+}
+
+#[test]
+fn trbdf2_is_second_order_on_the_oscillator_the_rotation_manifold_and_a_hertz_contact() {
+    let oscillator: Vec<f64> = [4e-3, 2e-3, 1e-3]
+        .iter()
+        .map(|&dt| {
+            let mut sim = oscillator_by("trbdf2", dt, 0.1, "");
+            sim.run().unwrap();
+            oscillator_error(&sim)
+        })
+        .collect();
+    let mut reference = tumbling("rk4", 1e-5);
+    reference.run().unwrap();
+    let i = common::body(&reference, "box");
+    let (r, w) = (reference.state().rot[i], reference.state().omega[i]);
+    let tumbling: Vec<f64> = [2e-2, 1e-2, 5e-3]
+        .iter()
+        .map(|&dt| {
+            let mut sim = self::tumbling("trbdf2", dt);
+            sim.run().unwrap();
+            let (q, v) = (sim.state().rot[i], sim.state().omega[i]);
+            q.angle_to(&r).max((v - w).norm() / w.norm())
+        })
+        .collect();
+    let hertz: Vec<f64> = [1e-5, 5e-6, 2.5e-6]
+        .iter()
+        .map(|&dt| hertz_energy_error("trbdf2", dt))
+        .collect();
+    // Positions and rotations: order 2. The energy of the undamped Hertz
+    // oscillation: order 3, because the method's local error on an
+    // oscillation is a phase error: its stability function has |R(iν)| =
+    // 1 − O(ν⁴) (−3.7e-7 at ν = 0.1, 16 times less at half ν) against a
+    // phase error O(ν³), so the amplitude errs by O(h⁴) a step.
+    for (name, errors, order) in [
+        ("oscillator", oscillator, 2.0),
+        ("tumbling", tumbling, 2.0),
+        ("hertz energy", hertz, 3.0),
+    ] {
+        let p = orders(&errors);
+        eprintln!("TR-BDF2 {name}: errors {errors:?}, orders {p:?}");
+        for p in &p {
+            assert!(
+                (p - order).abs() < 0.25,
+                "{name}: order {p:.3} ({errors:?})"
+            );
+        }
+    }
+}
+
+#[test]
+fn trbdf2_estimates_the_error_of_the_solution_it_goes_on_with() {
+    // Without local extrapolation the estimate is the local error of the
+    // second-order solution itself: summed over the run it is O(h²), like
+    // the global error, and within a factor of 2 of it on the oscillator
+    // (its damping lets the local errors add up almost undamped over 0.1 s).
+    let mut ratios = vec![];
+    let mut sums = vec![];
+    for dt in [4e-3, 2e-3, 1e-3] {
+        let mut sim = oscillator_by("trbdf2", dt, 0.1, "");
+        sim.run().unwrap();
+        let e = sim.error_stats().expect("trbdf2 has an estimate");
+        assert_eq!((e.accepted, e.rejected), (sim.steps(), 0));
+        sums.push(e.position_error);
+        ratios.push(e.position_error / oscillator_error(&sim));
+    }
+    let p = orders(&sums);
+    eprintln!("TR-BDF2 estimate sums {sums:?}, orders {p:?}, estimate / error {ratios:?}");
+    for p in &p {
+        assert!((p - 2.0).abs() < 0.2, "estimate order {p:.3} ({sums:?})");
+    }
+    for r in &ratios {
+        assert!((0.5..2.0).contains(r), "estimate / error {ratios:?}");
+    }
+}
+
+#[test]
+fn trbdf2_adaptive_error_follows_the_tolerance() {
+    // Each step's estimate of the second-order solution's own local error
+    // is held to the tolerance: steps ∝ tol^(1/3), and N ∝ tol^(-1/3) local
+    // errors of ~tol add up to a global error ∝ tol^(2/3), 4.6 times smaller
+    // per decade (ESDIRK3(2), which goes on with its third-order solution,
+    // gains 10).
+    let mut errors = vec![];
+    let mut steps = vec![];
+    for rtol in [1e-4, 1e-5, 1e-6] {
+        let extra = format!("rtol = {rtol}\natol = {}\nmax_step = 0.01", rtol * 1e-2);
+        let mut sim = oscillator_by("trbdf2", 0.01, 0.1, &extra);
+        sim.run().unwrap();
+        assert!((sim.time() - 0.1).abs() < 1e-15, "landed at {}", sim.time());
+        let e = sim.error_stats().expect("trbdf2 has an estimate");
+        errors.push(oscillator_error(&sim));
+        steps.push((e.accepted, e.rejected, e.smallest_step));
+    }
+    eprintln!("TR-BDF2 adaptive errors {errors:?}, (accepted, rejected, smallest) {steps:?}");
+    for w in errors.windows(2) {
+        let ratio = w[0] / w[1];
+        assert!(
+            (2.5..9.0).contains(&ratio),
+            "error ratio {ratio:.2} ({errors:?})"
+        );
+    }
+    assert!(steps[2].0 > 2 * steps[0].0, "{steps:?}");
+}
+
+#[test]
+fn trbdf2_converges_on_prothero_robinson_and_starts_each_step_from_the_last_stage() {
+    // Stiffly accurate with stage order 2, as ESDIRK3(2): errors of order
+    // h²/|λ| without resolving the fast scale.
+    let errors = prothero_robinson_errors("trbdf2");
+    let p = orders(&errors);
+    eprintln!("TR-BDF2 Prothero-Robinson errors {errors:?}, orders {p:?}");
+    assert!(errors[0] < 1e-5, "{errors:?}");
+    for p in &p {
+        assert!((p - 2.0).abs() < 0.3, "observed order {p:.3} ({errors:?})");
+    }
+    // First same as last: the last of its three stages is the next step's first.
+    let linear = "{ law = \"linear\", stiffness = 1e4, damping = 20.0 }";
+    let mut sim = landing_by("trbdf2", linear, "dt = 1e-3\noutput_interval = 1e-3");
+    sim.run().unwrap();
+    assert_eq!(sim.steps(), 100);
+    assert_eq!(first_stage_evaluations(&sim), 1);
 }

@@ -74,7 +74,7 @@ def add(commands: Commands) -> None:
         metavar="RUNS",
         help=(
             "repeat the run ten times tighter (dt/d with d = ceil(10^(1/order)), e.g. dt/4 for sdirk2, with a tenth "
-            "of the Newton tolerance for sdirk2 and esdirk32; rtol/10 for adaptive steps), write the difference of "
+            "of the Newton tolerance for sdirk2, trbdf2 and esdirk32; rtol/10 for adaptive steps), write the difference of "
             "each headline quantity (a drill pipe's comparison quantities, a generic scene's summary statistics) to "
             "verify.parquet and end with the largest: the run's measured "
             "error; a failed verification run exits 1, the run's own tables written. --verify 2 adds a second "

@@ -21,8 +21,8 @@ __all__ = ["TIGHTER", "Tighter", "cost_factor", "tighter"]
 #: A run's error bound falls by this factor in the verification run.
 TIGHTER = 10
 #: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' fixed-step integrators,
-#: not ESDIRK3(2); `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
-_OPT_IN_ORDERS = {"esdirk32": 3}
+#: not the adaptive pairs; `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
+_OPT_IN_ORDERS = {"esdirk32": 3, "trbdf2": 2}
 
 
 @dataclass(frozen=True)
@@ -42,7 +42,7 @@ class Tighter:
 
 
 #: The integrators whose stages are solved by Newton iterations to ``simulation.newton.tolerance``.
-NEWTON_INTEGRATORS = ("sdirk2", "esdirk32")
+NEWTON_INTEGRATORS = ("sdirk2", "esdirk32", "trbdf2")
 #: The absolute tolerances of ``[simulation]``: ``atol`` and one per quantity.
 ATOL_KEYS = ("atol", "atol_position", "atol_rotation", "atol_velocity", "atol_angular_velocity")
 
@@ -55,10 +55,10 @@ def tighter(scene: _native.Scene, times: int = 1) -> Tighter:
       per-quantity ``atol_*``) over 10 (unset, they follow rtol). ``max_step``, the largest step, is kept.
     - Fixed steps: ``dt/d`` with d = ceil(10^(1/p)), p the integrator's order
       (symplectic-euler and linearly-implicit-euler 1 → dt/10, sdirk2 2 →
-      dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
+      dt/4, trbdf2 2 → dt/4, esdirk32 3 → dt/3, rk4 4 → dt/2), so the error bound C·dt^p falls
       by d^p ≥ 10. ``simulation.output_interval``, k·dt, is k·d of the new
-      step, so the frames are the same. The Newton iterations of sdirk2 and
-      esdirk32 stop at ``simulation.newton.tolerance`` whatever the step, an
+      step, so the frames are the same. The Newton iterations of sdirk2,
+      trbdf2 and esdirk32 stop at ``simulation.newton.tolerance`` whatever the step, an
       error of their own: it is divided by 10 as well. (With adaptive steps
       they stop at min(tolerance, rtol/10), which follows rtol.)
 

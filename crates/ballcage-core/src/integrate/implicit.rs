@@ -88,6 +88,8 @@ pub(crate) enum Scheme {
     Sdirk2,
     /// Kennedy–Carpenter ESDIRK3(2)4L[2]SA ([`esdirk`]).
     Esdirk32,
+    /// TR-BDF2 as Hosea and Shampine's ESDIRK2(3) ([`esdirk`]).
+    Trbdf2,
 }
 
 impl Scheme {
@@ -95,7 +97,16 @@ impl Scheme {
     fn gamma(self) -> f64 {
         match self {
             Self::Sdirk2 => GAMMA,
-            Self::Esdirk32 => esdirk::GAMMA,
+            Self::Esdirk32 | Self::Trbdf2 => self.tableau().expect("an ESDIRK pair").gamma,
+        }
+    }
+
+    /// The tableau of an ESDIRK pair (`None`: SDIRK2).
+    fn tableau(self) -> Option<&'static esdirk::Tableau> {
+        match self {
+            Self::Sdirk2 => None,
+            Self::Esdirk32 => Some(&esdirk::ESDIRK32),
+            Self::Trbdf2 => Some(&esdirk::TRBDF2),
         }
     }
 
@@ -105,7 +116,9 @@ impl Scheme {
     /// step's).
     fn newton_tolerance(self, model: &Model) -> f64 {
         match (self, model.tolerance) {
-            (Self::Esdirk32, Some(tol)) => model.newton.tolerance.min(0.1 * tol.rtol),
+            (Self::Esdirk32 | Self::Trbdf2, Some(tol)) => {
+                model.newton.tolerance.min(0.1 * tol.rtol)
+            }
             _ => model.newton.tolerance,
         }
     }
@@ -114,7 +127,7 @@ impl Scheme {
     fn name(self) -> &'static str {
         match self {
             Self::Sdirk2 => "SDIRK2",
-            Self::Esdirk32 => "ESDIRK3(2)",
+            Self::Esdirk32 | Self::Trbdf2 => self.tableau().expect("an ESDIRK pair").name,
         }
     }
 }
@@ -538,7 +551,7 @@ impl Implicit {
         self.stats.deepest_halving = self.stats.deepest_halving.max(depth);
         let single = match self.scheme {
             Scheme::Sdirk2 => self.sdirk2_single(model, dynamics, state, h),
-            Scheme::Esdirk32 => self.esdirk_single(model, dynamics, state, h),
+            Scheme::Esdirk32 | Scheme::Trbdf2 => self.esdirk_single(model, dynamics, state, h),
         };
         match single {
             Err(_) if depth < MAX_HALVINGS => {
@@ -672,7 +685,7 @@ impl Implicit {
                 self.theta_step = Some(theta);
             }
             // SDIRK2 waits for a rate of its own.
-            let rate = theta.or((self.scheme == Scheme::Esdirk32).then(|| self.borrowed_rate()));
+            let rate = theta.or((self.scheme != Scheme::Sdirk2).then(|| self.borrowed_rate()));
             previous = norm;
             if converged(norm, rate, self.scheme.newton_tolerance(model)) {
                 self.set_stage(model, start, stage, s, t_stage, h);
@@ -839,7 +852,7 @@ impl Implicit {
                     }
                 }
             }
-            Scheme::Esdirk32 => self.esdirk_base(model, h),
+            Scheme::Esdirk32 | Scheme::Trbdf2 => self.esdirk_base(model, h),
         }
         self.place_stage(model, start, stage, t_stage, h);
     }

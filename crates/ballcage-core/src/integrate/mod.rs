@@ -6,7 +6,8 @@
 //! unit sphere by more than round-off.
 //!
 //! [`IntegratorKind::LinearlyImplicitEuler`], [`IntegratorKind::Sdirk2`] and
-//! [`IntegratorKind::Esdirk32`] ([`implicit`], `esdirk.rs`) also see the Jacobian of the forces, through
+//! [`IntegratorKind::Esdirk32`] and [`IntegratorKind::Trbdf2`] ([`implicit`], `esdirk.rs`) also see the
+//! Jacobian of the forces, through
 //! [`Dynamics::forces_and_jacobian`].
 
 mod blocklu;
@@ -114,7 +115,7 @@ pub fn step(
             implicit(ws, model).step(model, dynamics, state, h)
         }
         IntegratorKind::Sdirk2 => implicit(ws, model).sdirk2_step(model, dynamics, state, h)?,
-        IntegratorKind::Esdirk32 => {
+        IntegratorKind::Esdirk32 | IntegratorKind::Trbdf2 => {
             implicit(ws, model).esdirk_step(model, dynamics, state, h, accepted)?
         }
     }
