@@ -62,6 +62,26 @@ def test_cli_run_writes_tables_and_scene_and_summarises_each(cli_out):
     assert "energy created at most " in lines[3]
     # Last, what the run cost: 0.2 s simulated with rk4 at 50 µs is 4000 steps.
     assert "0.2 s simulated" in lines[4] and "real-time factor" in lines[4] and "4000 steps" in lines[4]
+
+
+@pytest.mark.parametrize(("integrator", "rtol", "stages"), [("esdirk32", 0.0, 3), ("trbdf2", 0.0, 2), ("trbdf2", 1e-4, 2)])
+def test_cli_run_states_the_cost_of_an_esdirk_pair_at_fixed_and_adaptive_steps(tmp_path, integrator, rtol, stages):
+    # Fixed steps (rtol 0) state the step and their count, adaptive ones the tolerance and the steps chosen; the
+    # Newton iterations per stage count the pair's own implicit stages (ESDIRK3(2) three a step, TR-BDF2 two).
+    out = tmp_path / "out"
+    integrate = ("--set", f'simulation.integrator="{integrator}"', "--set", f"simulation.rtol={rtol}")
+    proc = _cli("run", str(BALL_DROP), "--out", str(out), *integrate)
+    assert proc.returncode == 0, proc.stderr
+    last = proc.stdout.splitlines()[-1]
+    meta = pq.read_table(out / "bodies.parquet").schema.metadata
+    accepted, rejected = int(meta[b"ballcage.accepted_steps"]), int(meta[b"ballcage.rejected_steps"])
+    if rtol:
+        assert f"{integrator} adaptive at rtol 0.0001, {accepted} steps ({rejected} rejected" in last
+    else:
+        assert f"{integrator} at 5e-05 s, 4000 steps" in last
+        assert (accepted, rejected) == (4000, 0)
+    per_stage = int(meta[b"ballcage.newton_iterations"]) / (stages * (accepted + rejected))
+    assert f", {per_stage:.2f} Newton iterations per stage" in last
     assert proc.stderr == ""  # a 0.2 s scene is too quick for a progress bar
 
 

@@ -271,8 +271,8 @@ def _cost(meta: dict[str, str]) -> str:
         f"ballcage: {simulated:.4g} s simulated in {float(meta['ballcage.wall_time_s']):.3g} s of wall time "
         f"(real-time factor {float(meta['ballcage.real_time_factor']):.3g}); "
     )
-    if meta.get("ballcage.accepted_steps") is not None:
-        # Adaptive steps (ESDIRK3(2) at simulation.rtol): the steps the integrator chose.
+    if meta.get("ballcage.rtol") is not None:
+        # Adaptive steps (an ESDIRK pair at simulation.rtol): the steps the integrator chose.
         line += (
             f"{meta['ballcage.integrator']} adaptive at rtol {float(meta['ballcage.rtol']):g}, "
             f"{meta['ballcage.accepted_steps']} steps ({meta['ballcage.rejected_steps']} rejected, "
