@@ -1,11 +1,16 @@
-//! ESDIRK3(2)4L[2]SA of Kennedy & Carpenter ("Diagonally implicit
-//! Runge–Kutta methods for ordinary differential equations. A review",
-//! NASA/TM-2016-219173, 2016): four stages, the first explicit, γ =
-//! 0.4358665; third order, L-stable, stiffly accurate, stage order 2, with an
-//! embedded second-order solution for the error estimate. The coefficients
-//! are those of SUNDIALS ARKODE's `ARKODE_ESDIRK324L2SA_4_2_3`
-//! (src/arkode/arkode_butcher_dirk.def, LLNL/sundials; A and b are those of
-//! the implicit table of ARK3(2)4L[2]SA, the embedding d is the method's own).
+//! The ESDIRK pairs, one code for two [`Tableau`]s:
+//! - ESDIRK3(2)4L[2]SA of Kennedy & Carpenter ("Diagonally implicit
+//!   Runge–Kutta methods for ordinary differential equations. A review",
+//!   NASA/TM-2016-219173, 2016): four stages, the first explicit, γ =
+//!   0.4358665; third order, L-stable, stiffly accurate, stage order 2, with
+//!   an embedded second-order solution for the error estimate. The
+//!   coefficients are those of SUNDIALS ARKODE's `ARKODE_ESDIRK324L2SA_4_2_3`
+//!   (src/arkode/arkode_butcher_dirk.def, LLNL/sundials; A and b are those of
+//!   the implicit table of ARK3(2)4L[2]SA, the embedding d is the method's
+//!   own).
+//! - TR-BDF2 as Hosea & Shampine's ESDIRK2(3) ([`TRBDF2`]): three stages,
+//!   γ = 1 − 1/√2, second order, L-stable, stiffly accurate, stage order 2,
+//!   with an embedded third-order solution.
 //!
 //! Applied to x' = v, M v' = f as SDIRK2 is ([`super`]): stage 1 is the
 //! start, V_1 = v_n with A_1 = M⁻¹(f − ω×I_wω)(x_n, v_n); each later stage i
@@ -19,7 +24,7 @@
 //! K_j = dexp⁻¹_{−ξ_j}(ω_j) (Runge–Kutta–Munthe-Kaas: without the dexp
 //! correction a rotation about a turning axis is second order only); K_i is
 //! solved with ξ_i by a few fixed-point iterations per body. The step ends
-//! at stage 4 (stiffly accurate). Its error estimate is the difference to
+//! at the last stage (stiffly accurate). Its error estimate is the difference to
 //! the embedded solution, h·Σ_j (b_j − d_j)·(K_j, A_j) on the displacements
 //! [m, rad] and velocities [m/s, rad/s].
 //!
