@@ -11,12 +11,13 @@ ideal-CV chain at loose tolerances"):
 - two references by different methods, SDIRK2 at 25 µs and ESDIRK3(2) at rtol 1e-6, 33 samples per link;
   their difference is the reference's own error;
 - the setting given by ``--set`` (default: rtol 3e-2, steps up to 20 ms, Newton 3e-3, 3 samples per link,
-  frames every 10 ms) with ``--integrator`` (default the scene's, ESDIRK3(2); ``trbdf2`` for TR-BDF2) seven times, its rtol scaled by 0.9, 0.95, 0.97, 1, 1.03, 1.05 and 1.1: a change no
-  result should care about, so the spread of the seven is what one run of that setting is worth.
+  frames every 10 ms) with ``--integrator`` (default the scene's, ESDIRK3(2); ``trbdf2`` for TR-BDF2) seven
+  times, its rtol scaled by 0.9, 0.95, 0.97, 1, 1.03, 1.05 and 1.1: a change no result should care about, so
+  the spread of the seven is what one run of that setting is worth.
 
 A draw whose run fails (``ballcage.SimulationError``: diverged, a step it cannot take) is listed with its
-message and counted, and the others go on. Prints each run's summed mean tube force (``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s),
-its difference from the SDIRK2 reference, the real-time factor of the run's metadata and its force
+message and counted, and the others go on. Prints each run's summed mean tube force
+(``tube_normal_mean_all_n`` over the window, default 0.4-1.8 s), its difference from the SDIRK2 reference, the real-time factor of the run's metadata and its force
 evaluations. With ``--verify 1`` or ``--verify 2`` each draw is run with ``simulate(..., verify=...)``, and
 the table adds what the verification says of the sum: its measured error (against the rtol/10 run) and, with
 2, the rtol/10 run's own error as the rtol/100 run measures it and whether that confirms the measured error
