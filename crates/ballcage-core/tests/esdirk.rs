@@ -700,8 +700,9 @@ fn trbdf2_adaptive_error_follows_the_tolerance() {
     // Each step's estimate of the second-order solution's own local error
     // is held to the tolerance: steps ∝ tol^(1/3), and N ∝ tol^(-1/3) local
     // errors of ~tol add up to a global error ∝ tol^(2/3), 4.6 times smaller
-    // per decade (ESDIRK3(2), which goes on with its third-order solution,
-    // gains 10).
+    // per decade (measured 4.5 and 4.4). The window excludes both 10, what
+    // ESDIRK3(2) gains going on with its third-order solution (measured 9.4
+    // and 9.0), and 2.2, a global error ∝ tol^(1/3).
     let mut errors = vec![];
     let mut steps = vec![];
     for rtol in [1e-4, 1e-5, 1e-6] {
@@ -717,7 +718,7 @@ fn trbdf2_adaptive_error_follows_the_tolerance() {
     for w in errors.windows(2) {
         let ratio = w[0] / w[1];
         assert!(
-            (2.5..9.0).contains(&ratio),
+            (3.5..6.0).contains(&ratio),
             "error ratio {ratio:.2} ({errors:?})"
         );
     }
