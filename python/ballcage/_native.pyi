@@ -236,10 +236,12 @@ def table_schema(name: _TableName | str) -> pa.Schema:
     """
 
 def integrator_facts() -> dict[str, dict[str, Any]]:
-    """Per integrator name: ``{"implicit": bool, "order": int, "description": str}``.
+    """Per integrator name, every one (the adaptive pairs ``esdirk32`` and ``trbdf2`` too, which `INTEGRATORS`
+    leaves out): ``{"implicit": bool, "order": int, "newton_stages": int | None, "description": str}``.
 
     Implicit integrators solve a linear system per step; explicit ones must
-    resolve the stiffest contact's period.
+    resolve the stiffest contact's period. ``newton_stages``: the implicit
+    stages a step solves by Newton iterations (``None`` for the others).
     """
 
 def whole_multiple(interval: float, step: float) -> int | None:

@@ -601,14 +601,17 @@ fn table_schema<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyAny>>
     PySchema::new(Arc::new(schema)).into_pyarrow(py)
 }
 
-/// Per integrator: whether it is implicit, its order and a description.
+/// Per integrator (every one, the adaptive pairs included): whether it is
+/// implicit, its order, the stages it solves by Newton iterations and a
+/// description.
 #[pyfunction]
 fn integrator_facts(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let out = PyDict::new(py);
-    for k in IntegratorKind::ALL {
+    for k in IntegratorKind::EVERY {
         let facts = PyDict::new(py);
         facts.set_item("implicit", k.is_implicit())?;
         facts.set_item("order", k.order())?;
+        facts.set_item("newton_stages", k.newton_stages())?;
         facts.set_item("description", k.description())?;
         out.set_item(k.name(), facts)?;
     }

@@ -116,26 +116,24 @@ def meta_int(meta: Mapping[str, str], key: str) -> int | None:
         return None
 
 
-#: Implicit stages per step of the ESDIRK pairs, which count their steps in ``ballcage.accepted_steps`` (every
-#: step and part step at fixed steps; the accepted ones with adaptive steps, beside ``ballcage.rejected_steps``).
-ESDIRK_IMPLICIT_STAGES = {"esdirk32": 3, "trbdf2": 2}
-
-
 def implicit_steps(meta: Mapping[str, str]) -> tuple[int, int] | None:
     """Steps an implicit run's integrator took and the implicit stages they solved, from its metadata.
 
-    The ESDIRK pairs (ESDIRK3(2), three implicit stages a step; TR-BDF2, two): their accepted and rejected
-    steps; SDIRK2: its steps and the part steps its halvings added, two stages each. ``None`` for the other
-    integrators.
+    Each step solves the integrator's ``newton_stages`` (`_native.integrator_facts`: ESDIRK3(2) three, TR-BDF2
+    and SDIRK2 two). The ESDIRK pairs count their steps in ``ballcage.accepted_steps`` and
+    ``ballcage.rejected_steps`` (at fixed steps every step and part step is an accepted one); SDIRK2 in
+    ``ballcage.steps`` and the part steps its halvings added. ``None`` for the integrators without Newton
+    iterations.
     """
+    facts = _native.integrator_facts().get(meta.get("ballcage.integrator", ""), {})
+    stages = facts.get("newton_stages")
+    if stages is None:
+        return None
     accepted, rejected = meta_int(meta, "ballcage.accepted_steps"), meta_int(meta, "ballcage.rejected_steps")
-    stages = ESDIRK_IMPLICIT_STAGES.get(meta.get("ballcage.integrator", ""))
-    if stages is not None and accepted is not None and rejected is not None:
+    if accepted is not None and rejected is not None:
         return accepted + rejected, stages * (accepted + rejected)
     steps, halvings = meta_int(meta, "ballcage.steps"), meta_int(meta, "ballcage.step_halvings") or 0
-    if meta.get("ballcage.integrator") == "sdirk2" and steps:
-        return steps + halvings, 2 * (steps + halvings)
-    return None
+    return (steps + halvings, stages * (steps + halvings)) if steps else None
 
 
 def newton_per_stage(meta: Mapping[str, str]) -> float | None:

@@ -20,9 +20,6 @@ __all__ = ["TIGHTER", "Tighter", "cost_factor", "tighter"]
 
 #: A run's error bound falls by this factor in the verification run.
 TIGHTER = 10
-#: Orders of the integrators `_native.integrator_facts` leaves out (it lists the studies' fixed-step integrators,
-#: not the adaptive pairs; `IntegratorKind::order` in crates/ballcage-core/src/scene/mod.rs is the source).
-_OPT_IN_ORDERS = {"esdirk32": 3, "trbdf2": 2}
 
 
 @dataclass(frozen=True)
@@ -42,7 +39,7 @@ class Tighter:
 
 
 #: The integrators whose stages are solved by Newton iterations to ``simulation.newton.tolerance``.
-NEWTON_INTEGRATORS = ("sdirk2", "esdirk32", "trbdf2")
+NEWTON_INTEGRATORS = tuple(name for name, facts in _native.integrator_facts().items() if facts["newton_stages"])
 #: The absolute tolerances of ``[simulation]``: ``atol`` and one per quantity.
 ATOL_KEYS = ("atol", "atol_position", "atol_rotation", "atol_velocity", "atol_angular_velocity")
 
@@ -80,7 +77,7 @@ def tighter(scene: _native.Scene, times: int = 1) -> Tighter:
                 overrides.append(f"simulation.{key}={simulation[key] / factor!r}")
         return Tighter(f"rtol/{factor}", tuple(overrides))
     name = simulation["integrator"]
-    order = _native.integrator_facts().get(name, {}).get("order") or _OPT_IN_ORDERS[name]
+    order = _native.integrator_facts()[name]["order"]
     d = math.ceil(TIGHTER ** (1.0 / order)) ** times
     overrides = [f"simulation.dt={simulation['dt'] / d!r}"]
     if name in NEWTON_INTEGRATORS:

@@ -895,8 +895,15 @@ mod tests {
         // Row sums are c; the order conditions of b and d (ESDIRK3(2): 3
         // and 2; TR-BDF2: 2 and 3); stage order 2; stiffly accurate (the
         // last row of A is b); TR-BDF2's γ is SDIRK2's.
-        for (tab, order_b, order_d) in [(&ESDIRK32, 3, 2), (&TRBDF2, 2, 3)] {
+        let pairs = [
+            (&ESDIRK32, IntegratorKind::Esdirk32, 3, 2),
+            (&TRBDF2, IntegratorKind::Trbdf2, 2, 3),
+        ];
+        for (tab, kind, order_b, order_d) in pairs {
             let name = tab.name;
+            // What the scene reports of it: its order and implicit stages.
+            assert_eq!(kind.order(), order_b, "{name}");
+            assert_eq!(kind.newton_stages(), Some(tab.last() as u32), "{name}");
             for s in 0..tab.stages {
                 let row: f64 = tab.a[s].iter().sum();
                 assert!((row - tab.c[s]).abs() < 1e-15, "{name} row {s}: {row}");

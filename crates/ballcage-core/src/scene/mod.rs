@@ -108,6 +108,27 @@ impl IntegratorKind {
         Self::Sdirk2,
     ];
 
+    /// Every integrator: [`IntegratorKind::ALL`] and the two adaptive pairs.
+    pub const EVERY: [Self; 6] = [
+        Self::SymplecticEuler,
+        Self::Rk4,
+        Self::LinearlyImplicitEuler,
+        Self::Sdirk2,
+        Self::Esdirk32,
+        Self::Trbdf2,
+    ];
+
+    /// The implicit stages a step solves by Newton iterations to
+    /// `simulation.newton.tolerance` (`None`: no Newton iterations). The
+    /// pairs' counts are their tableaus' (a test in `integrate/esdirk.rs`).
+    pub fn newton_stages(self) -> Option<u32> {
+        match self {
+            Self::Sdirk2 | Self::Trbdf2 => Some(2),
+            Self::Esdirk32 => Some(3),
+            Self::SymplecticEuler | Self::Rk4 | Self::LinearlyImplicitEuler => None,
+        }
+    }
+
     /// Whether the step solves a linear system (the implicit integrators);
     /// an explicit integrator's step must resolve the stiffest contact.
     pub fn is_implicit(self) -> bool {
