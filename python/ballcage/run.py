@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TextIO, TypeVar
 
 from ballcage import _native
 from ballcage._files import parquet_writer, write_all_atomically
-from ballcage.scene import SceneSource, load_scene
+from ballcage.scene import BALL_KEY_HINGES, SceneSource, load_scene
 
 if TYPE_CHECKING:
     import pyarrow as pa
@@ -229,6 +229,12 @@ class Run:
         if self._scene is None:
             self._scene = _native.Scene.from_toml(self._scene_toml)
         return self._scene
+
+    @property
+    def has_ball_keys(self) -> bool:
+        """Whether the run is of a drill pipe whose hinges have cages and ball keys (``pipe.hinge`` in
+        `ballcage.scene.BALL_KEY_HINGES`), whose joint loads are contacts."""
+        return self.scene.kind == "drill-pipe" and self.scene.value("pipe.hinge") in BALL_KEY_HINGES
 
     def write(self, directory: str | os.PathLike[str]) -> dict[str, Path]:
         """Writes ``<table>.parquet`` (zstd) for every table, ``scene.toml`` and ``verify.parquet`` into `directory`.

@@ -303,6 +303,10 @@ def proposals(kind: str | None = None) -> pa.Table:
     return pa.Table.from_pylist(_native.proposals(kind), schema=schema)
 
 
+#: The hinge models with a cage and ball keys (their joint loads are contacts): ``pipe.hinge`` values.
+BALL_KEY_HINGES = ("ball-keys", "ball-keys-qs")
+
+
 def override_list(overrides: Iterable[str]) -> list[str]:
     """`overrides` (``dotted.key=value`` strings) as a list; `ballcage.InputError` for a single string.
 

@@ -482,6 +482,10 @@ impl WorldBuilder {
                 &format!("bodies[{i}].motion"),
                 "a spin-slide body has no rapier model here",
             )),
+            MotionKind::QuasiStatic | MotionKind::QuasiStaticPosition => Err(err(
+                &format!("bodies[{i}].motion"),
+                "a quasi-static body has no rapier model here",
+            )),
         }
     }
 

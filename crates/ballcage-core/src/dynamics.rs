@@ -200,6 +200,8 @@ pub struct Dynamics {
     /// Each pair's impulse as the integrator applied it, when a table
     /// records it ([`Dynamics::track_impulses`]).
     impulses: Option<Impulses>,
+    /// The quasi-static groups' solutions and scratch (`None`: the model has none).
+    groups: Option<Box<quasistatic::Groups>>,
 }
 
 /// What the contact points evaluated since the last
@@ -330,6 +332,7 @@ impl Dynamics {
             evaluations: 0,
             watch: ContactWatch::default(),
             impulses: None,
+            groups: quasistatic::Groups::new(model),
         }
     }
 
@@ -360,7 +363,7 @@ impl Dynamics {
                     };
                     acc.ang[i] = axis_body * (self.torque[i].dot(&axis) / inertia);
                 }
-                Motion::Fixed | Motion::KinematicSpin(_) => {}
+                Motion::Fixed | Motion::KinematicSpin(_) | Motion::QuasiStatic(_) => {}
             }
         }
     }
@@ -369,6 +372,21 @@ impl Dynamics {
     /// body (world frame, torques about the centres of mass, no gyroscopic
     /// term); with `jac`, also their velocity Jacobian.
     fn loads_joints_contacts(
+        &mut self,
+        model: &Model,
+        state: &State,
+        mode: Mode,
+        jac: Option<&mut VelocityJacobian>,
+    ) {
+        match self.groups.take() {
+            None => self.loads_at(model, state, mode, jac),
+            Some(groups) => self.loads_with_groups(model, state, mode, jac, groups),
+        }
+    }
+
+    /// [`Self::loads_joints_contacts`] at `state` as it is (its
+    /// quasi-static bodies, if any, where `state` has them).
+    fn loads_at(
         &mut self,
         model: &Model,
         state: &State,
@@ -424,7 +442,10 @@ impl Dynamics {
         jac: Option<&mut VelocityJacobian>,
     ) {
         let n = model.pairs.len();
-        let scale = jac.as_ref().map_or(0.0, |j| j.stiffness_scale);
+        let scale = Weights {
+            damping: 1.0,
+            stiffness: jac.as_ref().map_or(0.0, |j| j.stiffness_scale),
+        };
         let omega = &self.omega_world;
         // A few tasks per thread: enough to balance, few enough to be cheap.
         let chunk = n.div_ceil(4 * self.threads());
@@ -716,6 +737,12 @@ fn bodies_energy(model: &Model, state: &State) -> Energy {
         kinetic += k;
         potential_gravity += g;
     }
+    // Quasi-static bodies: no inertia in the dynamics, but their weight.
+    for group in &model.static_groups {
+        for &(i, _) in &group.free {
+            potential_gravity += body_energy(model, state, i).1;
+        }
+    }
     Energy {
         kinetic,
         potential_gravity,
@@ -733,8 +760,8 @@ fn elastic_energy(pair: &ContactPair, points: &[ContactPoint]) -> f64 {
 
 /// Stage 3 for pair `k`, on its own: finds its points into its `slots`,
 /// latches onsets in [`Mode::Commit`], evaluates the laws and, with the
-/// slots' coupling, fills the pair's Jacobian blocks (stiffness weight
-/// `scale`).
+/// slots' coupling, fills the pair's Jacobian blocks (their damping and
+/// stiffness weighted by `scale`).
 #[inline]
 fn evaluate_pair(
     model: &Model,
@@ -742,7 +769,7 @@ fn evaluate_pair(
     mode: Mode,
     k: usize,
     slots: &mut PairSlots,
-    scale: f64,
+    scale: Weights,
 ) {
     let pair = &model.pairs[k];
     find_points(model, pair, state, &mut slots.points);
@@ -911,6 +938,14 @@ fn evaluate_point_full(
     )
 }
 
+/// How a contact's Jacobian blocks weigh its two parts: D (damping and
+/// friction, ∂F/∂twist) and K (stiffness, ∂F/∂pose): D·`damping` + K·`stiffness`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Weights {
+    damping: f64,
+    stiffness: f64,
+}
+
 /// A 6×6 block of a velocity Jacobian.
 pub type Mat6 = nalgebra::Matrix6<f64>;
 
@@ -940,6 +975,30 @@ pub struct CouplingJacobian {
 }
 
 impl CouplingJacobian {
+    /// Zero blocks between bodies `a` and `b`.
+    pub fn zeros(a: usize, b: usize) -> Self {
+        Self {
+            a,
+            b,
+            active: false,
+            aa: Mat6::zeros(),
+            ab: Mat6::zeros(),
+            ba: Mat6::zeros(),
+            bb: Mat6::zeros(),
+        }
+    }
+
+    /// Zeroes the blocks.
+    pub fn clear(&mut self) {
+        if self.active {
+            self.active = false;
+            self.aa.fill(0.0);
+            self.ab.fill(0.0);
+            self.ba.fill(0.0);
+            self.bb.fill(0.0);
+        }
+    }
+
     /// Adds the blocks of force G·v_rel acting on b at arm `r_b` (and its
     /// reaction on a at arm `r_a`), v_rel the velocity of b's point relative
     /// to a's.
@@ -952,7 +1011,8 @@ impl CouplingJacobian {
         self.aa += aa;
     }
 
-    /// Adds contact point `e` of `pair` (stiffness weight `scale`).
+    /// Adds contact point `e` of `pair` (its damping and stiffness
+    /// weighted by `w`).
     fn add_contact_point(
         &mut self,
         state: &State,
@@ -960,15 +1020,16 @@ impl CouplingJacobian {
         point: &ContactPoint,
         e: &PointLaw,
         d: &PointDerivatives,
-        scale: f64,
+        w: Weights,
     ) {
-        let g = contact_velocity_gradient(&point.normal, e, d, scale);
+        let g = contact_velocity_gradient(&point.normal, e, d, w);
         if g != Mat3::zeros() {
             let p = point.point;
             self.add_gradient(&g, &(p - state.pos[pair.a]), &(p - state.pos[pair.b]));
         }
-        if scale != 0.0 && e.normal_force != 0.0 {
-            self.add_turning(state, pair, (point, e), scale, scale * d.d_depth);
+        let s = w.stiffness;
+        if s != 0.0 && e.normal_force != 0.0 {
+            self.add_turning(state, pair, (point, e), s, s * d.d_depth);
         }
     }
 
@@ -1080,25 +1141,17 @@ pub struct VelocityJacobian {
 }
 
 impl VelocityJacobian {
-    /// Zero blocks shaped for `model`.
+    /// Zero blocks shaped for `model`: its pairs', its joints', then its
+    /// quasi-static groups' ([`quasistatic::group_couplings`]).
     pub fn new(model: &Model) -> Self {
         let ends = model
             .pairs
             .iter()
             .map(|p| (p.a, p.b))
-            .chain(model.joints.iter().map(|j| (j.a, j.b)));
+            .chain(model.joints.iter().map(|j| (j.a, j.b)))
+            .chain(quasistatic::group_couplings(model));
         Self {
-            couplings: ends
-                .map(|(a, b)| CouplingJacobian {
-                    a,
-                    b,
-                    active: false,
-                    aa: Mat6::zeros(),
-                    ab: Mat6::zeros(),
-                    ba: Mat6::zeros(),
-                    bb: Mat6::zeros(),
-                })
-                .collect(),
+            couplings: ends.map(|(a, b)| CouplingJacobian::zeros(a, b)).collect(),
             stiffness_scale: 0.0,
         }
     }
@@ -1106,13 +1159,7 @@ impl VelocityJacobian {
     /// Zeroes every block.
     pub fn clear(&mut self) {
         for c in &mut self.couplings {
-            if c.active {
-                c.active = false;
-                c.aa.fill(0.0);
-                c.ab.fill(0.0);
-                c.ba.fill(0.0);
-                c.bb.fill(0.0);
-            }
+            c.clear();
         }
     }
 
@@ -1193,11 +1240,12 @@ impl VelocityJacobian {
 ///
 /// With a stiffness scale s the normal stiffness joins the damping: the
 /// point's relative displacement s·v_rel deepens the contact by −s·n·v_rel,
-/// so ∂F_n/∂δ̇ becomes ∂F_n/∂δ̇ + s·∂F_n/∂δ.
-fn contact_velocity_gradient(n: &Vec3, e: &PointLaw, d: &PointDerivatives, s: f64) -> Mat3 {
+/// so ∂F_n/∂δ̇ becomes ∂F_n/∂δ̇ + s·∂F_n/∂δ. With a damping weight 0
+/// only that stiffness is left (a quasi-static group's K).
+fn contact_velocity_gradient(n: &Vec3, e: &PointLaw, d: &PointDerivatives, w: Weights) -> Mat3 {
     let n = *n;
-    let mut g = d.friction * (Mat3::identity() - n * n.transpose());
-    let normal = d.d_rate + s * d.d_depth;
+    let mut g = w.damping * d.friction * (Mat3::identity() - n * n.transpose());
+    let normal = w.damping * d.d_rate + w.stiffness * d.d_depth;
     if e.normal_force != 0.0 && normal != 0.0 {
         let along = n + e.tangential_force / e.normal_force;
         g -= normal * along * n.transpose();

@@ -27,6 +27,70 @@ pub enum Motion {
         /// Whether the centre of mass is free to slide along `axis`.
         slides: bool,
     },
+    /// Not integrated: at every force evaluation its pose (or position)
+    /// is solved for static equilibrium among the bodies it touches,
+    /// which are held ([`StaticGroup`]; a quasi-static hinge's cage and
+    /// keys, issue 28).
+    QuasiStatic(StaticDofs),
+}
+
+/// Which of a quasi-static body's pose coordinates its equilibrium solves for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StaticDofs {
+    /// Position and orientation: 6 coordinates.
+    Pose,
+    /// Position only (a ball, whose turn carries no load without friction):
+    /// 3 coordinates.
+    Position,
+}
+
+impl StaticDofs {
+    /// Coordinates solved for.
+    pub fn dim(self) -> usize {
+        match self {
+            Self::Pose => 6,
+            Self::Position => 3,
+        }
+    }
+}
+
+/// Quasi-static bodies connected by contact pairs, solved together for
+/// equilibrium with the bodies they touch outside the group held.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StaticGroup {
+    /// The group's bodies and the coordinates solved for, in body order.
+    pub free: Vec<(usize, StaticDofs)>,
+    /// The bodies outside the group that its pairs touch, in body order:
+    /// what the group acts on as a force element.
+    pub held: Vec<usize>,
+    /// Every contact pair with a body of the group, in pair order.
+    pub pairs: Vec<usize>,
+    /// Per free body, per held body: the free body's pose in the held
+    /// body's frame in the initial state (position [m], rotation). The mean
+    /// of the poses the held bodies carry it to is its kinematic pose
+    /// ([`StaticGroup::kinematic_pose`]).
+    pub carried: Vec<Vec<(Vec3, Quat)>>,
+}
+
+impl StaticGroup {
+    /// Free body `f`'s (its index in `free`) kinematic pose at `state`: the
+    /// mean of the poses each held body carries it to from the initial
+    /// state (for a hinge's two links, the cage on the bisecting plane).
+    pub fn kinematic_pose(&self, f: usize, state: &State) -> (Vec3, Quat) {
+        let n = self.held.len() as f64;
+        let (mut x, mut q) = (Vec3::zeros(), nalgebra::Quaternion::new(0.0, 0.0, 0.0, 0.0));
+        for (&h, (p, r)) in self.held.iter().zip(&self.carried[f]) {
+            x += state.pos[h] + state.rot[h] * p;
+            let carried = (state.rot[h] * r).into_inner();
+            // The same hemisphere as the first, so that the sum is a mean.
+            q += if q.dot(&carried) < 0.0 {
+                -carried
+            } else {
+                carried
+            };
+        }
+        (x / n, Quat::from_quaternion(q))
+    }
 }
 
 /// A spin drive: speed ramped by an Adams STEP from 0 to `speed` over `ramp`.
@@ -254,6 +318,8 @@ pub struct Model {
     pub forces: Vec<ForceLoad>,
     /// Penalty joints.
     pub joints: Vec<Joint>,
+    /// Groups of quasi-static bodies, solved at every force evaluation.
+    pub static_groups: Vec<StaticGroup>,
     /// Gravity [m/s²], world frame.
     pub gravity: Vec3,
     /// Integrator.

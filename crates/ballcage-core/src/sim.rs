@@ -127,11 +127,12 @@ impl Simulation {
     /// metadata. Records the frame at `state`.
     pub fn from_model(
         model: Model,
-        state: State,
+        mut state: State,
         observers: Vec<Box<dyn Observer>>,
         scene_toml: String,
     ) -> Self {
         let mut dynamics = Dynamics::new(&model);
+        dynamics.settle_groups(&model, &mut state);
         let workspace = Workspace::new(&state);
         let mut recorder = Recorder::new(&model, observers);
         if recorder.needs_impulses() {
@@ -281,6 +282,9 @@ impl Simulation {
             return self.fail_with(reason, Failure::Integrator);
         }
         self.step += 1;
+        // The quasi-static bodies where the held ones are now (the
+        // integrator moves only the integrated bodies).
+        self.dynamics.settle_groups(&self.model, &mut self.state);
         if let Some(reason) = self.non_finite() {
             return self.fail_with(reason, Failure::NotFinite);
         }
@@ -348,6 +352,7 @@ impl Simulation {
         let stats = self.workspace.stats();
         let (smallest, error_metadata) = (self.smallest_step(), self.error_metadata());
         let closest_metadata = self.closest_metadata();
+        let group_metadata = self.group_metadata();
         let mut metadata = vec![
             ("ballcage.scene".to_string(), self.scene_toml),
             ("ballcage.version".to_string(), crate::VERSION.to_string()),
@@ -397,6 +402,7 @@ impl Simulation {
         ];
         metadata.extend(error_metadata);
         metadata.extend(closest_metadata);
+        metadata.extend(group_metadata);
         if let Some(e) = &self.failed {
             metadata.push(("ballcage.error".to_string(), e.to_string()));
         }
@@ -409,6 +415,23 @@ impl Simulation {
             part_labels,
             metadata,
         }
+    }
+
+    /// What the quasi-static groups' solves did (`ballcage.static_*`;
+    /// nothing for a model without quasi-static bodies).
+    fn group_metadata(&self) -> Vec<(String, String)> {
+        let Some(g) = self.dynamics.group_stats() else {
+            return vec![];
+        };
+        [
+            ("solves", g.solves),
+            ("iterations", g.iterations),
+            ("restarts", g.restarts),
+            ("failures", g.failures),
+        ]
+        .into_iter()
+        .map(|(k, v)| (format!("ballcage.static_{k}"), v.to_string()))
+        .collect()
     }
 
     /// The smallest step or part step taken [s]: `simulation.dt` halved as

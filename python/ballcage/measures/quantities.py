@@ -322,7 +322,7 @@ def column_peaks(
 
 def _cage_peaks(run: Run, times: np.ndarray | None = None) -> dict[str, Peak] | None:
     """`CAGE_PEAKS` of a ball-key pipe; ``None`` without cages (another hinge) or a hinges table."""
-    if run.scene.value("pipe.hinge") != "ball-keys":
+    if not run.has_ball_keys:
         return None
     return column_peaks(run, "hinges", ["hinge"], CAGE_PEAKS, times)
 

@@ -247,7 +247,7 @@ def section_loads(run: Run, sections: list[Section] | None = None) -> SectionLoa
     """
     scene = run.scene
     secs = link_sections(run) if sections is None else sections
-    if scene.value("pipe.hinge") != "ball-keys":
+    if not run.has_ball_keys:
         raise InputError(
             f"pipe.hinge = {scene.value('pipe.hinge')!r}: section loads need the ball-key hinge, whose joint loads "
             "are contacts; the ideal CV joint's forces are not recorded"

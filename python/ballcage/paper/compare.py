@@ -392,7 +392,7 @@ def _cage_values(run: Run) -> dict[str, _Value]:
     if "hinges" not in run.tables:
         return {k: _Value(None, "not computed: the run did not record the hinges table") for k in CAGE_PEAKS}
     peaks: dict[str, Peak] | None = None
-    if run.scene.value("pipe.hinge") == "ball-keys":
+    if run.has_ball_keys:
         peaks = column_peaks(run, "hinges", ["hinge"], CAGE_PEAKS)
     if peaks is None:
         why = f"not computed: pipe.hinge = {run.scene.value('pipe.hinge')!r} has no cages"

@@ -3,7 +3,7 @@
 use crate::error::SceneError;
 use crate::geometry::{Shape, TubePath, TubeSegment};
 use crate::math::{Quat, Vec3};
-use crate::model::{Body, Motion, SpinProfile, State};
+use crate::model::{Body, Motion, SpinProfile, State, StaticDofs};
 use crate::scene::{BodySpec, MotionKind, Scene, ShapeSpec, TubeSegmentSpec};
 
 /// Every body of the scene, in order (index = body id).
@@ -22,7 +22,7 @@ fn body(b: &BodySpec, path: &str) -> Result<Body, SceneError> {
     let rot = Quat::from_quaternion(nalgebra::Quaternion::new(q0[0], q0[1], q0[2], q0[3]));
     let (mass, inertia) = match b.mass_properties() {
         Some((m, i3)) => (m, Vec3::from(i3)),
-        None if b.is_integrated() => {
+        None if b.needs_mass() => {
             return Err(SceneError::new(format!("{path}.mass"), "", "missing"));
         }
         None => (0.0, Vec3::zeros()),
@@ -47,6 +47,8 @@ fn motion(b: &BodySpec, rot: &Quat, inertia: &Vec3) -> Motion {
     match b.motion {
         MotionKind::Fixed => Motion::Fixed,
         MotionKind::Dynamic => Motion::Dynamic,
+        MotionKind::QuasiStatic => Motion::QuasiStatic(StaticDofs::Pose),
+        MotionKind::QuasiStaticPosition => Motion::QuasiStatic(StaticDofs::Position),
         MotionKind::KinematicSpin => Motion::KinematicSpin(SpinProfile {
             axis,
             speed: b.spin_speed,

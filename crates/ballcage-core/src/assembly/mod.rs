@@ -13,8 +13,10 @@
 //! | `pairs` | contact pairs: geometry, laws, penetration limit |
 //! | `laws` | force laws as written → SI laws |
 //! | `joints` | joints and torque loads |
+//! | `groups` | quasi-static bodies grouped for their equilibrium solves |
 
 mod bodies;
+mod groups;
 mod joints;
 mod laws;
 mod pairs;
@@ -43,6 +45,7 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
     let joints = joints::joints(scene)?;
     let record = record_plan(scene, &bodies, &pairs)?;
     let mut state = bodies::initial_state(scene, &bodies);
+    let static_groups = groups::static_groups(&bodies, &pairs, &state)?;
     let integrated = (0..bodies.len())
         .filter(|&i| bodies[i].is_integrated())
         .collect();
@@ -53,6 +56,7 @@ pub fn assemble_validated(scene: &Scene) -> Result<(Model, State), SceneError> {
         torques,
         forces,
         joints,
+        static_groups,
         gravity: Vec3::from(scene.world.gravity),
         integrator: scene.simulation.integrator,
         dt: scene.simulation.step(),

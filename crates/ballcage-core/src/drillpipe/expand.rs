@@ -49,7 +49,7 @@ impl DrillPipeSpec {
         for h in 0..=self.pipe.joints {
             match self.pipe.hinge {
                 HingeModel::IdealCv => b.ideal_cv_hinge(h),
-                HingeModel::BallKeys => b.ball_key_hinge(h),
+                HingeModel::BallKeys | HingeModel::BallKeysQs => b.ball_key_hinge(h),
             }
         }
         let expansion = b.finish();
@@ -490,9 +490,14 @@ impl<'a> Builder<'a> {
         let (head, seat) = (self.chain_name(h), self.chain_name(h + 1));
         let beta = chain::bend_angle(&self.place.axes[h], &self.place.axes[h + 1], &BEND_NORMAL);
         let r_cage = self.place.rotations[h] * Quat::from_axis_angle(&Vec3::z_axis(), beta / 2.0);
+        let quasi_static = self.spec.pipe.hinge == HingeModel::BallKeysQs;
         let cage = BodySpec {
             name: names::cage(h),
-            motion: MotionKind::Dynamic,
+            motion: if quasi_static {
+                MotionKind::QuasiStatic
+            } else {
+                MotionKind::Dynamic
+            },
             shape: ShapeSpec::Ball {
                 radius: kb.cage_outer_radius,
             },
@@ -589,7 +594,11 @@ impl<'a> Builder<'a> {
         let p_hinge = cv.ball_centre_in_groove(beta, psi);
         let body = BodySpec {
             name: names::key(h, j),
-            motion: MotionKind::Dynamic,
+            motion: if self.spec.pipe.hinge == HingeModel::BallKeysQs {
+                MotionKind::QuasiStaticPosition
+            } else {
+                MotionKind::Dynamic
+            },
             shape: ShapeSpec::Ball {
                 radius: kb.ball_radius,
             },

@@ -74,6 +74,20 @@ pub enum HingeModel {
     BallKeys,
     /// Reduced model: ideal constant-velocity joints, link–tube contacts only.
     IdealCv,
+    /// The paper's hinge with its cage and keys quasi-static (issue 28):
+    /// the same bodies, contacts and laws as `ball-keys`, but at every force
+    /// evaluation the cage and keys are solved for equilibrium between the
+    /// two links, which they act on as a force element; they move with the
+    /// mean of the links' motions (the bisecting plane). Experimental: the
+    /// paper's scene stops at 22 ms (docs/engine.md, "Quasi-static bodies").
+    BallKeysQs,
+}
+
+impl HingeModel {
+    /// Whether the hinge has a cage and ball keys (`ball-keys`, `ball-keys-qs`).
+    pub fn has_keys(self) -> bool {
+        matches!(self, Self::BallKeys | Self::BallKeysQs)
+    }
 }
 
 /// How the lower connector is held (docs/paper.md, "The chain's end restraint").
@@ -310,7 +324,11 @@ impl PipeSpec {
     /// The unit and meaning of each field.
     pub const FIELDS: &'static [FieldDoc] = &[
         FieldDoc::number("joints", "-", "number of flexible joints (links)"),
-        FieldDoc::text("hinge", "hinge model: ball-keys or ideal-cv"),
+        FieldDoc::text(
+            "hinge",
+            "hinge model: ball-keys, ideal-cv, or ball-keys-qs (cage and keys quasi-static; experimental: \
+             stops at 22 ms on the paper's scene, docs/engine.md)",
+        ),
         FieldDoc::number("pitch", "m", "hinge-to-hinge pitch, one link's length"),
         FieldDoc::number("link_diameter", "m", "link outer diameter for tube contact"),
         FieldDoc::number("link_mass", "kg", "link mass"),
@@ -891,6 +909,7 @@ impl DrillPipeSpec {
         }
         let hinge = match self.pipe.hinge {
             HingeModel::BallKeys => "ball-cage",
+            HingeModel::BallKeysQs => "quasi-static ball-cage",
             HingeModel::IdealCv => "ideal-CV",
         };
         let what = format!(

@@ -127,6 +127,62 @@ impl ContactTable {
     }
 }
 
+impl ContactTable {
+    /// Calls `one(k, slots)` for each pair k of `pairs` in turn, on this
+    /// thread, with `couplings[i]` for `pairs[i]` when given (a
+    /// quasi-static group's own blocks); sets each pair's count of points.
+    pub fn each_listed<F>(
+        &mut self,
+        pairs: &[usize],
+        mut couplings: Option<&mut [CouplingJacobian]>,
+        one: F,
+    ) where
+        F: Fn(usize, &mut PairSlots),
+    {
+        for (i, &k) in pairs.iter().enumerate() {
+            let mut slots = pair_slots(
+                (
+                    &mut self.points[..],
+                    &mut self.laws[..],
+                    &mut self.latched[..],
+                ),
+                (self.start[k], self.start[k + 1]),
+                (self.memory[k], self.memory[k + 1]),
+                couplings.as_deref_mut().map(|c| &mut c[i]),
+            );
+            one(k, &mut slots);
+            self.used[k] = slots.points.len;
+        }
+    }
+}
+
+/// The points, laws and latched speeds of a run of slots.
+type SlotArrays<'a> = (
+    &'a mut [ContactPoint],
+    &'a mut [(PointLaw, PointDerivatives)],
+    &'a mut [Option<f64>],
+);
+
+/// One pair's slots: `points[s..e]`, `laws[s..e]` and `latched[ms..me]`,
+/// with its Jacobian blocks when the evaluation fills them.
+fn pair_slots<'a>(
+    (points, laws, latched): SlotArrays<'a>,
+    (s, e): (usize, usize),
+    (ms, me): (usize, usize),
+    coupling: Option<&'a mut CouplingJacobian>,
+) -> PairSlots<'a> {
+    PairSlots {
+        points: SlotSink {
+            slots: &mut points[s..e],
+            len: 0,
+            turning: coupling.is_some(),
+        },
+        laws: &mut laws[s..e],
+        latched: &mut latched[ms..me],
+        coupling,
+    }
+}
+
 /// The slots of the pairs `first..first + used.len()`: the offset tables
 /// are absolute, the slices start at the range's first pair.
 struct Range<'a> {
@@ -147,18 +203,16 @@ impl Range<'_> {
         let mut couplings = self.couplings;
         for (i, used) in self.used.iter_mut().enumerate() {
             let k = self.first + i;
-            let (s, e) = (self.start[k] - s0, self.start[k + 1] - s0);
-            let (ms, me) = (self.memory[k] - m0, self.memory[k + 1] - m0);
-            let mut slots = PairSlots {
-                points: SlotSink {
-                    slots: &mut self.points[s..e],
-                    len: 0,
-                    turning: couplings.is_some(),
-                },
-                laws: &mut self.laws[s..e],
-                latched: &mut self.latched[ms..me],
-                coupling: couplings.as_deref_mut().map(|c| &mut c[i]),
-            };
+            let mut slots = pair_slots(
+                (
+                    &mut self.points[..],
+                    &mut self.laws[..],
+                    &mut self.latched[..],
+                ),
+                (self.start[k] - s0, self.start[k + 1] - s0),
+                (self.memory[k] - m0, self.memory[k + 1] - m0),
+                couplings.as_deref_mut().map(|c| &mut c[i]),
+            );
             one(k, &mut slots);
             *used = slots.points.len;
         }

@@ -25,6 +25,15 @@ pub enum MotionKind {
     /// cylindrical joint to the ground: a connector whose centre of mass
     /// moves only along the axis, e.g. to carry an axial force).
     SpinSlide,
+    /// Not integrated: at every force evaluation its pose is solved for
+    /// static equilibrium with the bodies outside its group held (a group:
+    /// quasi-static bodies joined by contact pairs), and it moves with the
+    /// mean of their rigid motions; it acts on them as a force element
+    /// (issue 28's quasi-static hinge: the cage).
+    QuasiStatic,
+    /// As `quasi-static`, its position only solved for, its orientation
+    /// kept (a ball, whose turn carries no load without friction: a key).
+    QuasiStaticPosition,
 }
 
 /// A body's shape, in its body frame.
@@ -359,7 +368,7 @@ impl BodySpec {
         FieldDoc::text("name", "unique body name"),
         FieldDoc::text(
             "motion",
-            "how the body moves: fixed, dynamic, kinematic-spin, spin or spin-slide",
+            "how the body moves: fixed, dynamic, kinematic-spin, spin, spin-slide, quasi-static or quasi-static-position",
         ),
         FieldDoc::table(
             "shape",
@@ -517,10 +526,24 @@ impl BodySpec {
         Ok(())
     }
 
+    /// Whether the body is solved for static equilibrium at every evaluation.
+    pub fn is_quasi_static(&self) -> bool {
+        matches!(
+            self.motion,
+            MotionKind::QuasiStatic | MotionKind::QuasiStaticPosition
+        )
+    }
+
+    /// Whether the body needs mass properties: integrated, or quasi-static
+    /// (its weight is part of its equilibrium).
+    pub fn needs_mass(&self) -> bool {
+        self.is_integrated() || self.is_quasi_static()
+    }
+
     /// What the motion needs: mass properties and no initial velocity
     /// unless integrated, a spin axis (and only then) for the spin motions.
     fn validate_motion(&self, path: &str) -> Result<(), SceneError> {
-        if self.is_integrated() {
+        if self.needs_mass() {
             if self.mass.is_none() && self.density.is_none() {
                 return Err(SceneError::new(
                     format!("{path}.mass"),
@@ -551,7 +574,9 @@ impl BodySpec {
                     ),
                 ));
             }
-        } else if !is_zero3(&self.velocity) || !is_zero3(&self.angular_velocity) {
+        }
+        if !self.is_integrated() && (!is_zero3(&self.velocity) || !is_zero3(&self.angular_velocity))
+        {
             return Err(SceneError::new(
                 format!("{path}.velocity"),
                 format!("{:?}", self.velocity),

@@ -67,6 +67,13 @@ impl JointSpec {
                 "a joint needs two bodies",
             ));
         }
+        if let Some(k) = (0..2).find(|&k| scene.bodies[idx[k]].is_quasi_static()) {
+            return Err(SceneError::new(
+                format!("{path}.bodies[{k}]"),
+                bodies[k].clone(),
+                "is quasi-static: its equilibrium is solved over contact pairs only, so it takes no joint",
+            ));
+        }
         if !scene.bodies[idx[0]].is_integrated() && !scene.bodies[idx[1]].is_integrated() {
             return Err(SceneError::new(
                 format!("{path}.bodies"),
