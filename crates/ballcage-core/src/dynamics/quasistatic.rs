@@ -3,7 +3,15 @@
 //! solved for given poses of head and seat, as a ball bearing's balls are
 //! between given rings in the quasi-static models of Jones and Harris).
 //!
-//! [`equilibrium`] moves the free bodies of a state, the others held, until
+//! In a run, the model's quasi-static groups ([`crate::model::StaticGroup`])
+//! are solved at every force evaluation ([`Groups`], `Dynamics::solve_groups`:
+//! Newton on the group's pairs alone with their exact stiffness, a trust
+//! region, a centring spring toward each body's kinematic pose, and the
+//! free bodies moving with the mean of the held ones), and hand the global
+//! Newton iterations the implicit function theorem's stiffness and damping
+//! (`condensed_correction`); docs/engine.md, "Quasi-static bodies".
+//!
+//! [`equilibrium`] (a standalone solve over every pair, for tests) moves the free bodies of a state, the others held, until
 //! the net force and torque on each vanish: Newton's method on the elastic
 //! forces, with the stiffness K = ∂(wrench)/∂(pose) that
 //! [`Dynamics::forces_and_jacobian`] gives for the implicit integrators (the
@@ -339,11 +347,11 @@ pub struct GroupStats {
 }
 
 /// When a group's solve within a force evaluation stops: at a net force
-/// within 1e-2 N and torque within 3e-4 N·m (the force at a 30 mm arm) on
-/// every free body, both scaled up to 1e-6 of the group's largest contact
-/// force where that is larger ([`LOAD_FRACTION`]: 1.3e-2 N at the 13.5 kN
-/// of a ball key in the paper's hinge), or after a Newton step within
-/// 1e-9 m and 1e-7 rad; 20 steps.
+/// within 1e-4 N and torque within 3e-6 N·m (the force at a 30 mm arm) on
+/// every free body, both scaled up with 1e-8 of the group's largest contact
+/// force where that is larger ([`LOAD_FRACTION`]: 1.35e-4 N at the 13.5 kN
+/// of a ball key in the paper's hinge), or after a full Newton step (not
+/// shortened by the line search) within 1e-11 m and 1e-9 rad; 20 steps.
 pub const GROUP_TOLERANCE: StaticTolerance = StaticTolerance {
     translation: 1e-11,
     rotation: 1e-9,
@@ -362,7 +370,8 @@ pub const GROUP_TOLERANCE: StaticTolerance = StaticTolerance {
 /// where the last solve ended. 1e3 N/m: a key's 0.14 N weight moves it
 /// 0.14 mm in its clearance; 1e-5 of the races' stiffness under the paper's
 /// 13.5 kN key load (about 1e8 N/m), so a loaded hinge's forces move by
-/// about that fraction (a test checks it).
+/// about that fraction (measured 7e-6 against the dynamic keys:
+/// tests/hinge_closed_forms.rs).
 pub const CENTRING: f64 = 1e3;
 
 /// The arm [m] that turns [`CENTRING`] into a rotational stiffness: a
@@ -378,7 +387,7 @@ const REACH: f64 = 2e-5;
 
 /// The fraction of a group's largest contact force its solve's force
 /// tolerance grows to, where that exceeds [`GROUP_TOLERANCE`]'s (and the
-/// torque tolerance with it): 1e-6.
+/// torque tolerance with it): 1e-8.
 const LOAD_FRACTION: f64 = 1e-8;
 
 /// The Jacobian blocks a group's solve uses: K alone.
@@ -474,8 +483,9 @@ impl Dynamics {
     /// Stages 1–3 at `state` with the quasi-static groups solved first
     /// (their bodies' poses from the last solution, solved again for the
     /// held bodies' poses at `state`, their velocities the mean of the held
-    /// bodies' rigid motions); with `jac`, each group's condensed stiffness
-    /// s·(−K_hf·K_ff⁻¹·K_fh) joins its couplings.
+    /// bodies' rigid motions), and their centring springs' reactions on the
+    /// held bodies; with `jac`, what each group adds to its held bodies'
+    /// Jacobian, C_D + s·C_K ([`condensed_correction`]), joins its couplings.
     pub(super) fn loads_with_groups(
         &mut self,
         model: &Model,
@@ -523,10 +533,15 @@ impl Dynamics {
     }
 
     /// Solves the quasi-static groups of `model` at `state` in place (the
-    /// held bodies as they are): what a handed-out state carries.
+    /// held bodies as they are): what a handed-out state carries. The net
+    /// wrenches of the last evaluation are left as they were (the drive's
+    /// work reads them); its contact points are no longer the kept ones.
     pub fn settle_groups(&mut self, model: &Model, state: &mut State) {
         if let Some(mut groups) = self.groups.take() {
+            let wrenches = (self.force.clone(), self.torque.clone());
             self.solve_groups(model, &mut groups, state, false);
+            (self.force, self.torque) = wrenches;
+            self.kept_valid = false;
             self.groups = Some(groups);
         }
     }
