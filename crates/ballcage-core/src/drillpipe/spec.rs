@@ -83,13 +83,6 @@ pub enum HingeModel {
     BallKeysQs,
 }
 
-impl HingeModel {
-    /// Whether the hinge has a cage and ball keys (`ball-keys`, `ball-keys-qs`).
-    pub fn has_keys(self) -> bool {
-        matches!(self, Self::BallKeys | Self::BallKeysQs)
-    }
-}
-
 /// How the lower connector is held (docs/paper.md, "The chain's end restraint").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
